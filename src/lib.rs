@@ -1,0 +1,2 @@
+//! Rosette: a woven-fabric simulator.
+pub mod sim;

@@ -1,0 +1,367 @@
+//! Fabric material laws: the in-plane strain energy of a woven sheet and its bending
+//! stiffness tensor.
+//!
+//! Conventions (REFERENCE.md §1): x is the warp, y the weft. `nu_xy` is the contraction
+//! along the weft per unit strain under a warp pull; reciprocity gives
+//! `nu_yx = nu_xy · E_y / E_x` from the small-strain moduli. Fabric quantities are per unit
+//! width: stresses and moduli in N/m, bending rigidities in N·m.
+
+use crate::sim::curve::{CurveError, PiecewiseLinear};
+use thiserror::Error;
+
+/// Measured properties of a fabric, in SI units per unit width.
+#[derive(Debug, Clone)]
+pub struct Fabric {
+    /// Mass per unit area, kg/m².
+    pub areal_density: f64,
+    /// Thickness, m (enters eq. 3's twisting term and the contact thickness).
+    pub thickness: f64,
+    /// Warp tensile curve: stress (N/m) against engineering strain, measured in a uniaxial pull.
+    pub tensile_warp: PiecewiseLinear,
+    /// Weft tensile curve: stress (N/m) against engineering strain.
+    pub tensile_weft: PiecewiseLinear,
+    /// In-plane shear modulus G, N/m (per radian of engineering shear strain).
+    pub shear_modulus: f64,
+    /// Poisson ratio ν_xy: weft contraction per unit warp strain in a warp pull.
+    pub poisson_warp: f64,
+    /// Bending rigidity for bending along the warp (curvature in the warp direction), N·m.
+    pub bending_warp: f64,
+    /// Bending rigidity for bending along the weft, N·m.
+    pub bending_weft: f64,
+    /// Measured rigidity of a strip cut at 45°, N·m; replaces eq. 3's middle term when given.
+    pub bending_bias: Option<f64>,
+}
+
+/// A fabric property that is out of range, named by its preset key.
+#[derive(Debug, Error, PartialEq)]
+pub enum FabricError {
+    #[error("fabric.{key} must be {expected}, got {value}")]
+    OutOfRange { key: &'static str, expected: &'static str, value: f64 },
+    #[error("fabric.{key}: {source}")]
+    Curve { key: &'static str, source: CurveError },
+    #[error(
+        "fabric.poisson_warp = {nu} makes the in-plane energy non-convex with these tensile curves \
+         (the material would have no stable state); use a value below {limit:.3} or stiffen the softest \
+         segments of the curves"
+    )]
+    PoissonTooLarge { nu: f64, limit: f64 },
+    #[error(
+        "fabric.bending_bias = {bias} N·m is too small for bending_warp = {warp} and bending_weft = {weft}: \
+         eq. 3 would need a negative twisting rigidity; use at least {min:.3e} N·m"
+    )]
+    BiasTooSmall { bias: f64, warp: f64, weft: f64, min: f64 },
+}
+
+fn positive(key: &'static str, value: f64) -> Result<(), FabricError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(FabricError::OutOfRange { key, expected: "a positive finite number", value })
+    }
+}
+
+impl Fabric {
+    /// Checks every property and that the laws built from them are stable.
+    pub fn validate(&self) -> Result<(), FabricError> {
+        positive("areal_density", self.areal_density)?;
+        positive("thickness", self.thickness)?;
+        positive("shear_modulus", self.shear_modulus)?;
+        positive("bending_warp", self.bending_warp)?;
+        positive("bending_weft", self.bending_weft)?;
+        if !(0.0..0.5).contains(&self.poisson_warp) {
+            return Err(FabricError::OutOfRange {
+                key: "poisson_warp",
+                expected: "in [0, 0.5)",
+                value: self.poisson_warp,
+            });
+        }
+        if let Some(bias) = self.bending_bias {
+            positive("bending_bias", bias)?;
+        }
+        MembraneLaw::new(self)?;
+        BendingStiffness::new(self)?;
+        Ok(())
+    }
+
+    /// Weight per unit area, N/m², under gravity `g` (m/s²).
+    pub fn weight_per_area(&self, g: f64) -> f64 {
+        self.areal_density * g
+    }
+}
+
+/// The in-plane strain energy density ψ(ε_xx, ε_yy, γ_xy), J/m², of an orthotropic sheet with
+/// nonlinear warp and weft curves and a linear Poisson coupling and shear.
+///
+/// ```text
+/// ψ = F_x(ε_xx) + F_y(ε_yy) + (νν / 2D)(E_x ε_xx² + E_y ε_yy²) + (ν_yx E_x / D) ε_xx ε_yy + ½ G γ²
+/// ```
+/// with `F' = f` the measured curves, `E` their small-strain slopes, `νν = ν_xy ν_yx` and
+/// `D = 1 − νν`. For linear curves this is exactly the plane-stress energy of paper eq. 1.
+/// For nonlinear curves the quadratic correction makes a uniaxial pull reproduce the
+/// measured curve exactly (σ_yy = 0 gives ε_yy = −ν_xy ε_xx and σ_xx = f_x(ε_xx)) as long as
+/// the lateral strain stays on the curves' first segment, which holds by default because
+/// compression continues the first tensile slope (see `curve`). A naive "secant modulus in
+/// eq. 1" would not be the gradient of any energy, and a plain separable energy would miss
+/// the measured curve by a factor of about ν_xy ν_yx of its nonlinear part.
+#[derive(Debug, Clone)]
+pub struct MembraneLaw {
+    warp: PiecewiseLinear,
+    weft: PiecewiseLinear,
+    /// Quadratic correction stiffnesses νν E_x / D and νν E_y / D, N/m.
+    correction_x: f64,
+    correction_y: f64,
+    /// Coupling stiffness ν_yx E_x / D = ν_xy E_y / D, N/m.
+    coupling: f64,
+    shear: f64,
+}
+
+impl MembraneLaw {
+    pub fn new(fabric: &Fabric) -> Result<Self, FabricError> {
+        let warp = fabric.tensile_warp.clone();
+        let weft = fabric.tensile_weft.clone();
+        let (ex, ey) = (warp.initial_slope(), weft.initial_slope());
+        let nu_xy = fabric.poisson_warp;
+        let nu_yx = nu_xy * ey / ex;
+        let nunu = nu_xy * nu_yx;
+        let d = 1.0 - nunu;
+        let law = Self {
+            correction_x: nunu * ex / d,
+            correction_y: nunu * ey / d,
+            coupling: nu_yx * ex / d,
+            shear: fabric.shear_modulus,
+            warp,
+            weft,
+        };
+        // Convexity needs the 2×2 normal block of the tangent to stay positive definite on
+        // the softest segments: (s_x + c_x)(s_y + c_y) > coupling².
+        let softest = (law.warp.min_slope() + law.correction_x) * (law.weft.min_slope() + law.correction_y);
+        if softest <= law.coupling * law.coupling * 1.0001 {
+            // The largest ν_xy that keeps the softest combination convex, by bisection.
+            let (mut lo, mut hi) = (0.0, nu_xy);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                let mut trial = fabric.clone();
+                trial.poisson_warp = mid;
+                let ok = {
+                    let nyx = mid * ey / ex;
+                    let nn = mid * nyx;
+                    let dd = 1.0 - nn;
+                    let s = (law.warp.min_slope() + nn * ex / dd) * (law.weft.min_slope() + nn * ey / dd);
+                    s > (nyx * ex / dd).powi(2) * 1.0001
+                };
+                if ok { lo = mid } else { hi = mid }
+            }
+            return Err(FabricError::PoissonTooLarge { nu: nu_xy, limit: lo });
+        }
+        Ok(law)
+    }
+
+    /// Energy density ψ, J/m², at strain `[ε_xx, ε_yy, γ_xy]`.
+    pub fn energy(&self, e: [f64; 3]) -> f64 {
+        self.warp.integral(e[0])
+            + self.weft.integral(e[1])
+            + 0.5 * (self.correction_x * e[0] * e[0] + self.correction_y * e[1] * e[1])
+            + self.coupling * e[0] * e[1]
+            + 0.5 * self.shear * e[2] * e[2]
+    }
+
+    /// Stress `[σ_xx, σ_yy, τ_xy]` = ∂ψ/∂ε, N/m.
+    pub fn stress(&self, e: [f64; 3]) -> [f64; 3] {
+        [
+            self.warp.value(e[0]) + self.correction_x * e[0] + self.coupling * e[1],
+            self.weft.value(e[1]) + self.correction_y * e[1] + self.coupling * e[0],
+            self.shear * e[2],
+        ]
+    }
+
+    /// Tangent stiffness ∂σ/∂ε, N/m (symmetric, positive definite).
+    pub fn tangent(&self, e: [f64; 3]) -> [[f64; 3]; 3] {
+        [
+            [self.warp.slope(e[0]) + self.correction_x, self.coupling, 0.0],
+            [self.coupling, self.weft.slope(e[1]) + self.correction_y, 0.0],
+            [0.0, 0.0, self.shear],
+        ]
+    }
+
+    /// Largest tangent stiffness the law can reach, N/m (bounds explicit time steps).
+    pub fn max_stiffness(&self) -> f64 {
+        (self.warp.max_slope() + self.correction_x).max(self.weft.max_slope() + self.correction_y) + self.coupling
+    }
+}
+
+/// Orthotropic plate bending stiffness in the warp frame, N·m:
+/// ψ_b = ½ (D11 κ_xx² + 2 D12 κ_xx κ_yy + D22 κ_yy² + 4 D66 κ_xy²).
+///
+/// For a cylindrical bend of curvature κ in direction θ from the warp, ψ_b = ½ B_θ κ² with
+/// B_θ = D11 cos⁴θ + (2 D12 + 4 D66) cos²θ sin²θ + D22 sin⁴θ: paper eq. 3 with D11 = B_x,
+/// D22 = B_y, D12 = ν_xy B_x and D66 = G h³/12 (G in Pa, i.e. the sheet modulus over h).
+/// A measured bias rigidity B_45 fixes the middle term instead: 2 D12 + 4 D66 = 4 B_45 − B_x − B_y.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BendingStiffness {
+    pub d11: f64,
+    pub d12: f64,
+    pub d22: f64,
+    pub d66: f64,
+}
+
+impl BendingStiffness {
+    pub fn new(fabric: &Fabric) -> Result<Self, FabricError> {
+        let (bx, by) = (fabric.bending_warp, fabric.bending_weft);
+        let poisson_term = fabric.poisson_warp * bx;
+        // G h³/12 with G in Pa = (sheet modulus / h) · h³ / 12.
+        let twist_paper = fabric.shear_modulus * fabric.thickness * fabric.thickness / 12.0;
+        let (d12, d66) = match fabric.bending_bias {
+            None => (poisson_term, twist_paper),
+            Some(bias) => {
+                let middle = 4.0 * bias - bx - by;
+                if middle <= 0.0 {
+                    return Err(FabricError::BiasTooSmall { bias, warp: bx, weft: by, min: (bx + by) / 4.0 * 1.001 });
+                }
+                // Keep the Poisson coupling where the middle term allows it; the rest is twist.
+                let d12 = poisson_term.min(0.25 * middle);
+                (d12, 0.25 * (middle - 2.0 * d12))
+            }
+        };
+        Ok(Self { d11: bx, d12, d22: by, d66 })
+    }
+
+    /// Isotropic stiffness with rigidity `b` in every direction (D12 + 2 D66 = b, no Poisson coupling).
+    pub fn isotropic(b: f64) -> Self {
+        Self { d11: b, d12: 0.0, d22: b, d66: 0.5 * b }
+    }
+
+    /// Rigidity for cylindrical bending at angle `theta` (radians) from the warp, N·m (eq. 3).
+    pub fn rigidity_at(&self, theta: f64) -> f64 {
+        let (s, c) = theta.sin_cos();
+        self.d11 * c.powi(4) + (2.0 * self.d12 + 4.0 * self.d66) * c * c * s * s + self.d22 * s.powi(4)
+    }
+
+    /// The matrix 𝔻 acting on `[κ_xx, κ_yy, κ_xy]` so that ψ_b = ½ κᵀ𝔻κ.
+    pub fn voigt(&self) -> [[f64; 3]; 3] {
+        [[self.d11, self.d12, 0.0], [self.d12, self.d22, 0.0], [0.0, 0.0, 4.0 * self.d66]]
+    }
+
+    /// Row of the free-edge condition m_νν = 0 in the unknowns `[κ_xx, κ_yy, κ_xy]`, for an
+    /// edge with unit outward normal `n` in the warp frame (m_xy = 2 D66 κ_xy).
+    pub fn free_edge_row(&self, n: [f64; 2]) -> [f64; 3] {
+        let (nx2, ny2, nxy) = (n[0] * n[0], n[1] * n[1], n[0] * n[1]);
+        [nx2 * self.d11 + ny2 * self.d12, nx2 * self.d12 + ny2 * self.d22, 2.0 * nxy * 2.0 * self.d66]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wool_like(poisson: f64) -> Fabric {
+        Fabric {
+            areal_density: 0.137,
+            thickness: 3.14e-4,
+            tensile_warp: PiecewiseLinear::new_material(&[[0.0, 0.0], [0.005, 5.0], [0.015, 20.0], [0.035, 98.0], [0.06, 490.5]])
+                .unwrap(),
+            tensile_weft: PiecewiseLinear::new_material(&[[0.0, 0.0], [0.01, 8.0], [0.04, 80.0]]).unwrap(),
+            shear_modulus: 40.0,
+            poisson_warp: poisson,
+            bending_warp: 1e-5,
+            bending_weft: 8e-6,
+            bending_bias: None,
+        }
+    }
+
+    /// Solves σ_yy(ε_xx, ε_yy) = 0 for ε_yy by Newton's method (a uniaxial warp pull).
+    fn lateral_strain(law: &MembraneLaw, exx: f64) -> f64 {
+        let mut eyy = 0.0;
+        for _ in 0..50 {
+            let s = law.stress([exx, eyy, 0.0])[1];
+            eyy -= s / law.tangent([exx, eyy, 0.0])[1][1];
+        }
+        eyy
+    }
+
+    #[test]
+    fn uniaxial_pull_reproduces_the_measured_curve_with_poisson_coupling() {
+        let fabric = wool_like(0.3);
+        let law = MembraneLaw::new(&fabric).unwrap();
+        let nu_xy = 0.3;
+        for i in 1..=40 {
+            let exx = 0.0015 * i as f64;
+            let eyy = lateral_strain(&law, exx);
+            let sxx = law.stress([exx, eyy, 0.0])[0];
+            let measured = fabric.tensile_warp.value(exx);
+            assert!((sxx - measured).abs() < 1e-9 * measured, "ε={exx}: {sxx} vs {measured}");
+            assert!((eyy + nu_xy * exx).abs() < 1e-12, "lateral contraction is ν_xy ε");
+        }
+    }
+
+    #[test]
+    fn linear_law_is_plane_stress_eq1() {
+        let mut fabric = wool_like(0.2);
+        fabric.tensile_warp = PiecewiseLinear::linear(1000.0);
+        fabric.tensile_weft = PiecewiseLinear::linear(500.0);
+        let law = MembraneLaw::new(&fabric).unwrap();
+        let (ex, ey, nxy) = (1000.0, 500.0, 0.2);
+        let nyx = nxy * ey / ex;
+        let d = 1.0 - nxy * nyx;
+        let e = [0.01, -0.004, 0.02];
+        let s = law.stress(e);
+        assert!((s[0] - ex / d * (e[0] + nyx * e[1])).abs() < 1e-12);
+        assert!((s[1] - ey / d * (nxy * e[0] + e[1])).abs() < 1e-12);
+        assert!((s[2] - 40.0 * e[2]).abs() < 1e-12);
+    }
+
+    #[test]
+    fn stress_is_the_gradient_of_energy() {
+        let law = MembraneLaw::new(&wool_like(0.25)).unwrap();
+        let e = [0.021, -0.007, 0.013];
+        let s = law.stress(e);
+        for k in 0..3 {
+            let mut ep = e;
+            let mut em = e;
+            ep[k] += 1e-7;
+            em[k] -= 1e-7;
+            let numeric = (law.energy(ep) - law.energy(em)) / 2e-7;
+            assert!((numeric - s[k]).abs() < 1e-5 * (1.0 + s[k].abs()), "component {k}");
+        }
+    }
+
+    #[test]
+    fn too_large_poisson_ratio_is_rejected_with_a_limit() {
+        let mut fabric = wool_like(0.49);
+        // A very soft compression branch makes the coupling dominate.
+        fabric.tensile_weft = PiecewiseLinear::new_material(&[[-0.01, -0.01], [0.0, 0.0], [0.01, 100.0]]).unwrap();
+        let err = MembraneLaw::new(&fabric).unwrap_err();
+        match err {
+            FabricError::PoissonTooLarge { limit, .. } => assert!(limit > 0.0 && limit < 0.49),
+            other => panic!("unexpected {other:?}"),
+        }
+    }
+
+    #[test]
+    fn eq3_directional_rigidity() {
+        let fabric = wool_like(0.2);
+        let d = BendingStiffness::new(&fabric).unwrap();
+        assert_eq!(d.rigidity_at(0.0), 1e-5);
+        assert!((d.rigidity_at(std::f64::consts::FRAC_PI_2) - 8e-6).abs() < 1e-18);
+        let g_pa = 40.0 / 3.14e-4;
+        let middle = 2.0 * 0.2 * 1e-5 + 4.0 * g_pa * 3.14e-4f64.powi(3) / 12.0;
+        let expected45 = 0.25 * (1e-5 + middle + 8e-6);
+        assert!((d.rigidity_at(std::f64::consts::FRAC_PI_4) - expected45).abs() < 1e-15);
+        let mut with_bias = fabric.clone();
+        with_bias.bending_bias = Some(6e-6);
+        let d = BendingStiffness::new(&with_bias).unwrap();
+        assert!((d.rigidity_at(std::f64::consts::FRAC_PI_4) - 6e-6).abs() < 1e-18);
+        with_bias.bending_bias = Some(1e-6);
+        assert!(matches!(BendingStiffness::new(&with_bias), Err(FabricError::BiasTooSmall { .. })));
+    }
+
+    #[test]
+    fn bad_values_name_their_key() {
+        let mut fabric = wool_like(0.2);
+        fabric.areal_density = -0.1;
+        let msg = fabric.validate().unwrap_err().to_string();
+        assert!(msg.contains("fabric.areal_density") && msg.contains("-0.1"), "{msg}");
+        let mut fabric = wool_like(0.7);
+        fabric.areal_density = 0.1;
+        assert!(fabric.validate().unwrap_err().to_string().contains("poisson_warp"));
+    }
+}

@@ -1,0 +1,14 @@
+//! The physics: meshes, fabric laws, the model's energies and the time integrators.
+//! No rendering, UI or file input/output here.
+pub mod curve;
+pub mod integrate;
+pub mod material;
+pub mod mesh;
+pub mod model;
+pub mod sparse;
+
+pub use curve::PiecewiseLinear;
+pub use integrate::{Integrator, IntegratorKind, NewtonSettings, State, StepError, StepReport};
+pub use material::{BendingStiffness, Fabric, FabricError, MembraneLaw};
+pub use mesh::{Mesh, MeshError, Pattern};
+pub use model::{EndMoment, Model, ModelError, Motion, PhysicsOptions};

@@ -1,0 +1,785 @@
+//! The fixed part of a simulation: rest geometry, masses, material laws, topology,
+//! constraints and loads. Positions and velocities live in [`State`](crate::sim::State).
+//!
+//! Energies and their gradients (forces) and Hessians are all here, so every integrator
+//! sees the same conservative model. Everything that a scene switches off (membrane,
+//! bending, gravity) is absent from the model, not multiplied by zero.
+
+use crate::sim::material::{BendingStiffness, Fabric, FabricError, MembraneLaw};
+use crate::sim::mesh::{Mesh, MeshError};
+use crate::sim::sparse::{BlockCsr, ScalarCsr};
+use glam::{DMat3, DVec2, DVec3};
+use std::collections::HashMap;
+use thiserror::Error;
+
+/// Which physics a scene enables. Anything off costs nothing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhysicsOptions {
+    /// In-plane strain-rosette elasticity.
+    pub membrane: bool,
+    /// Out-of-plane bending.
+    pub bending: bool,
+    /// Gravitational acceleration, m/s² (zero turns gravity off).
+    pub gravity: DVec3,
+    /// Mass-proportional (air) damping rate ζ, 1/s: the drag force is −ζ·m·v.
+    pub damping: f64,
+}
+
+impl Default for PhysicsOptions {
+    fn default() -> Self {
+        Self { membrane: true, bending: true, gravity: DVec3::new(0.0, 0.0, -9.81), damping: 0.0 }
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum ModelError {
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    #[error(transparent)]
+    Fabric(#[from] FabricError),
+    #[error(
+        "the bending stencil of triangle {triangle} is singular (its neighbours are nearly collinear \
+         with it); use a less distorted mesh or another mesh.pattern"
+    )]
+    SingularBendingStencil { triangle: usize },
+    #[error("solver.damping must be zero or positive (1/s), got {0}")]
+    BadDamping(f64),
+}
+
+/// Prescribed motion of a group of vertices: displacement `velocity · clamp(t − start, 0, stop − start)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Motion {
+    /// Velocity while moving, m/s.
+    pub velocity: DVec3,
+    /// Time the motion starts, s.
+    pub start: f64,
+    /// Time the motion stops (the group then holds still), s.
+    pub stop: f64,
+}
+
+impl Motion {
+    pub const STILL: Motion = Motion { velocity: DVec3::ZERO, start: 0.0, stop: 0.0 };
+
+    pub fn displacement(&self, t: f64) -> DVec3 {
+        self.velocity * (t - self.start).clamp(0.0, (self.stop - self.start).max(0.0))
+    }
+}
+
+/// A conservative end moment: pairs of vertices (inner, outer) whose direction is turned by
+/// moments `m_j` (N·m each) in the plane spanned by `e1` (along the strip) and `e2`.
+/// Potential V = −Σ m_j φ_j with φ_j = atan2(t·e2, t·e1), t = x_outer − x_inner.
+#[derive(Debug, Clone)]
+pub struct EndMoment {
+    pub pairs: Vec<(u32, u32, f64)>,
+    pub e1: DVec3,
+    pub e2: DVec3,
+}
+
+/// Rest data of one triangle's strain rosette (paper Fig. 1).
+#[derive(Debug, Clone)]
+struct RosetteTriangle {
+    vertices: [u32; 3],
+    /// Rest area, m².
+    area: f64,
+    /// Rest length of edge k (opposite vertex k, from vertex k+1 to vertex k+2), m.
+    rest_length: [f64; 3],
+    /// Maps the three edge strains to `[ε_xx, ε_yy, γ_xy]` in the warp frame.
+    strain_from_edges: [[f64; 3]; 3],
+    /// Slots in the stiffness matrix of block (vertex a, vertex b), row-major a·3+b.
+    slots: [u32; 9],
+}
+
+/// The model: rest state, material, topology, constraints and loads.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub options: PhysicsOptions,
+    /// Rest positions in the sample plane, m.
+    pub rest: Vec<DVec2>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Lumped vertex masses, kg.
+    pub mass: Vec<f64>,
+    /// Lumped vertex areas, m² (a third of each adjacent triangle).
+    pub vertex_area: Vec<f64>,
+    /// Warp direction in the sample plane, radians from the sample's x axis.
+    pub warp_angle: f64,
+    pub mean_edge_length: f64,
+    membrane_law: Option<MembraneLaw>,
+    rosettes: Vec<RosetteTriangle>,
+    pub bending_stiffness: BendingStiffness,
+    /// The bending energy is ½ Σ Q_ab x_a·x_b (see [`Model::bending_matrix`]).
+    bending: Option<ScalarCsr>,
+    /// Per-triangle bending stencils (the Hessian x_,ij = Σ_a W_a x_a on each triangle).
+    bending_patches: Vec<BendingPatch>,
+    /// Pattern of the in-plane stiffness matrix.
+    stiffness_pattern: BlockCsr,
+    /// Vertices whose positions are prescribed.
+    pub fixed: Vec<bool>,
+    anchor: Vec<DVec3>,
+    driver: Vec<u16>,
+    motions: Vec<Motion>,
+    pub end_moments: Vec<EndMoment>,
+    /// Undirected edges (a < b), for strain checks and drawing.
+    pub edges: Vec<[u32; 2]>,
+}
+
+/// Rotates a sample-plane vector into the warp frame (x along the warp).
+fn to_warp_frame(p: DVec2, warp_angle: f64) -> DVec2 {
+    DVec2::from_angle(-warp_angle).rotate(p)
+}
+
+impl Model {
+    /// Builds a model of `mesh` cut from `fabric` with the warp at `warp_angle` radians from
+    /// the sample's x axis.
+    pub fn new(mesh: &Mesh, fabric: &Fabric, warp_angle: f64, options: PhysicsOptions) -> Result<Self, ModelError> {
+        mesh.validate()?;
+        fabric.validate()?;
+        if !(options.damping >= 0.0 && options.damping.is_finite()) {
+            return Err(ModelError::BadDamping(options.damping));
+        }
+        let n = mesh.rest.len();
+        let mut vertex_area = vec![0.0; n];
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let a = mesh.signed_area(t);
+            for &v in tri {
+                vertex_area[v as usize] += a / 3.0;
+            }
+        }
+        let mass = vertex_area.iter().map(|a| a * fabric.areal_density).collect();
+        let mut edge_set: Vec<[u32; 2]> =
+            mesh.triangles.iter().flat_map(|t| (0..3).map(move |k| sorted_edge(t[(k + 1) % 3], t[(k + 2) % 3]))).collect();
+        edge_set.sort_unstable();
+        edge_set.dedup();
+
+        let stiffness_pattern = BlockCsr::with_pattern(n, edge_set.iter().map(|e| (e[0], e[1])));
+        let membrane_law = if options.membrane { Some(MembraneLaw::new(fabric)?) } else { None };
+        let rosettes = if options.membrane {
+            mesh.triangles
+                .iter()
+                .enumerate()
+                .map(|(t, tri)| rosette(mesh, t, *tri, warp_angle, &stiffness_pattern))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let bending_stiffness = BendingStiffness::new(fabric)?;
+        let (bending, bending_patches) = if options.bending {
+            let patches = bending_patches(mesh, warp_angle, &bending_stiffness)?;
+            (Some(bending_matrix(n, &patches, &bending_stiffness)), patches)
+        } else {
+            (None, Vec::new())
+        };
+        Ok(Self {
+            options,
+            rest: mesh.rest.clone(),
+            triangles: mesh.triangles.clone(),
+            mass,
+            vertex_area,
+            warp_angle,
+            mean_edge_length: mesh.mean_edge_length(),
+            membrane_law,
+            rosettes,
+            bending_stiffness,
+            bending,
+            bending_patches,
+            stiffness_pattern,
+            fixed: vec![false; n],
+            anchor: vec![DVec3::ZERO; n],
+            driver: vec![0; n],
+            motions: vec![Motion::STILL],
+            end_moments: Vec::new(),
+            edges: edge_set,
+        })
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.rest.len()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Holds vertex `v` at `position` for the whole run.
+    pub fn pin(&mut self, v: u32, position: DVec3) {
+        self.fixed[v as usize] = true;
+        self.anchor[v as usize] = position;
+        self.driver[v as usize] = 0;
+    }
+
+    /// Moves the given vertices, starting from `positions`, with `motion`.
+    pub fn drive(&mut self, vertices: &[u32], positions: &[DVec3], motion: Motion) {
+        self.motions.push(motion);
+        let id = (self.motions.len() - 1) as u16;
+        for &v in vertices {
+            self.fixed[v as usize] = true;
+            self.anchor[v as usize] = positions[v as usize];
+            self.driver[v as usize] = id;
+        }
+    }
+
+    /// Prescribed position of a fixed vertex at time `t`.
+    pub fn prescribed_position(&self, v: usize, t: f64) -> DVec3 {
+        self.anchor[v] + self.motions[self.driver[v] as usize].displacement(t)
+    }
+
+    /// Total potential energy (elastic + gravity + applied moments), J.
+    pub fn potential_energy(&self, x: &[DVec3]) -> f64 {
+        let mut energy = 0.0;
+        if let Some(law) = &self.membrane_law {
+            for tri in &self.rosettes {
+                let (strain, _, _) = rosette_strain(tri, x);
+                energy += tri.area * law.energy(strain);
+            }
+        }
+        if let Some(q) = &self.bending {
+            energy += 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>();
+        }
+        if self.options.gravity != DVec3::ZERO {
+            energy -= x.iter().zip(&self.mass).map(|(p, m)| m * self.options.gravity.dot(*p)).sum::<f64>();
+        }
+        for load in &self.end_moments {
+            for &(inner, outer, m) in &load.pairs {
+                let t = x[outer as usize] - x[inner as usize];
+                energy -= m * t.dot(load.e2).atan2(t.dot(load.e1));
+            }
+        }
+        energy
+    }
+
+    /// Elastic energy only (membrane + bending), J.
+    pub fn elastic_energy(&self, x: &[DVec3]) -> (f64, f64) {
+        let membrane = match &self.membrane_law {
+            Some(law) => self.rosettes.iter().map(|tri| tri.area * law.energy(rosette_strain(tri, x).0)).sum(),
+            None => 0.0,
+        };
+        let bending = match &self.bending {
+            Some(q) => 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>(),
+            None => 0.0,
+        };
+        (membrane, bending)
+    }
+
+    /// Total conservative force −∇E on every vertex, N (overwrites `f`).
+    pub fn forces(&self, x: &[DVec3], f: &mut [DVec3]) {
+        f.fill(DVec3::ZERO);
+        if self.options.gravity != DVec3::ZERO {
+            for (fi, m) in f.iter_mut().zip(&self.mass) {
+                *fi += *m * self.options.gravity;
+            }
+        }
+        self.add_membrane_forces(x, f);
+        if let Some(q) = &self.bending {
+            let mut qx = vec![DVec3::ZERO; x.len()];
+            q.multiply_add(x, &mut qx);
+            for (fi, q) in f.iter_mut().zip(qx) {
+                *fi -= q;
+            }
+        }
+        for load in &self.end_moments {
+            for &(inner, outer, m) in &load.pairs {
+                let t = x[outer as usize] - x[inner as usize];
+                let (u, w) = (t.dot(load.e1), t.dot(load.e2));
+                let r2 = u * u + w * w;
+                // dφ/dt for φ = atan2(w, u).
+                let grad = (-w * load.e1 + u * load.e2) / r2;
+                f[outer as usize] += m * grad;
+                f[inner as usize] -= m * grad;
+            }
+        }
+    }
+
+    /// In-plane (strain rosette) forces.
+    ///
+    /// ```text
+    ///        v2            Each triangle is a strain rosette: its edge strains
+    ///       /  \           ε_k = l_k/L_k − 1 give [ε_xx, ε_yy, γ_xy] = T⁻¹ ε (paper §1),
+    ///   e1 /    \ e0       the law gives σ = ∂ψ/∂ε, and each edge carries the tension
+    ///     /      \         A (T⁻ᵀσ)_k / L_k along its current direction: the paper's
+    ///   v0 ------ v1       "stresses converted to edge forces", here as −∂(Aψ)/∂x.
+    ///         e2
+    /// ```
+    fn add_membrane_forces(&self, x: &[DVec3], f: &mut [DVec3]) {
+        let Some(law) = &self.membrane_law else { return };
+        for tri in &self.rosettes {
+            let (strain, dirs, _) = rosette_strain(tri, x);
+            let tension = edge_tensions(tri, law.stress(strain));
+            for k in 0..3 {
+                let (a, b) = edge_vertices(tri, k);
+                let pull = tension[k] * dirs[k];
+                f[a as usize] += pull;
+                f[b as usize] -= pull;
+            }
+        }
+    }
+
+    /// Assembles the in-plane stiffness (the Hessian of the membrane energy, with the
+    /// geometric stiffness of compressed edges dropped so that it stays positive
+    /// semi-definite) into `k`, which must have this model's pattern.
+    pub fn assemble_membrane_stiffness(&self, x: &[DVec3], k: &mut BlockCsr) {
+        k.clear();
+        let Some(law) = &self.membrane_law else { return };
+        for tri in &self.rosettes {
+            let (strain, dirs, lengths) = rosette_strain(tri, x);
+            let c = law.tangent(strain);
+            let g = &tri.strain_from_edges;
+            // Material stiffness in edge-strain space: A · Tᵀ C T, scaled by 1/(L_k L_l).
+            let mut ke = [[0.0; 3]; 3];
+            for p in 0..3 {
+                for q in 0..3 {
+                    let mut s = 0.0;
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            s += g[i][p] * c[i][j] * g[j][q];
+                        }
+                    }
+                    ke[p][q] = tri.area * s / (tri.rest_length[p] * tri.rest_length[q]);
+                }
+            }
+            let tension = edge_tensions(tri, law.stress(strain));
+            // Vertex `v` of the triangle moves edge k's length by sign(k, v) · dirs[k].
+            let sign = |k: usize, v: usize| -> f64 {
+                if v == (k + 2) % 3 {
+                    1.0
+                } else if v == (k + 1) % 3 {
+                    -1.0
+                } else {
+                    0.0
+                }
+            };
+            for a in 0..3 {
+                for b in 0..3 {
+                    let mut block = DMat3::ZERO;
+                    for p in 0..3 {
+                        let sp = sign(p, a);
+                        if sp == 0.0 {
+                            continue;
+                        }
+                        for q in 0..3 {
+                            let sq = sign(q, b);
+                            if sq == 0.0 {
+                                continue;
+                            }
+                            block += outer(dirs[p], dirs[q]) * (sp * sq * ke[p][q]);
+                        }
+                        // Geometric stiffness of a stretched edge: (t/l)(I − uuᵀ).
+                        let sb = sign(p, b);
+                        if tension[p] > 0.0 && sb != 0.0 {
+                            let geo = (DMat3::IDENTITY - outer(dirs[p], dirs[p])) * (tension[p] / lengths[p]);
+                            block += geo * (sp * sb);
+                        }
+                    }
+                    k.values[tri.slots[a * 3 + b] as usize] += block;
+                }
+            }
+        }
+    }
+
+    /// A zero matrix with the in-plane stiffness pattern.
+    pub fn stiffness_matrix(&self) -> BlockCsr {
+        self.stiffness_pattern.clone()
+    }
+
+    /// The constant bending matrix Q (energy ½ Σ Q_ab x_a·x_b), if bending is on.
+    pub fn bending_matrix(&self) -> Option<&ScalarCsr> {
+        self.bending.as_ref()
+    }
+
+    /// Curvature `[κ_xx, κ_yy, κ_xy]` (1/m, warp frame) of every triangle, signed by the
+    /// triangle's normal (x_,ij · n). Empty when bending is off.
+    pub fn triangle_curvatures(&self, x: &[DVec3]) -> Vec<[f64; 3]> {
+        self.bending_patches
+            .iter()
+            .zip(&self.triangles)
+            .map(|(patch, tri)| {
+                let [a, b, c] = tri.map(|v| x[v as usize]);
+                let normal = (b - a).cross(c - a).normalize_or_zero();
+                let h = patch.hessian(x);
+                h.map(|v| v.dot(normal))
+            })
+            .collect()
+    }
+
+    /// Bending energy of each triangle's patch, J (they sum to the total bending energy).
+    pub fn triangle_bending_energies(&self, x: &[DVec3]) -> Vec<f64> {
+        let d = self.bending_stiffness.voigt();
+        self.bending_patches
+            .iter()
+            .map(|patch| {
+                let h = patch.hessian(x);
+                let mut e = 0.0;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        e += d[i][j] * h[i].dot(h[j]);
+                    }
+                }
+                0.5 * patch.area * e
+            })
+            .collect()
+    }
+
+    /// Whether triangle `t` has a neighbour across each of its edges.
+    pub fn is_interior_triangle(&self, t: usize) -> bool {
+        self.bending_patches.get(t).is_some_and(|p| p.vertices.len() == 6)
+    }
+
+    pub fn has_membrane(&self) -> bool {
+        self.membrane_law.is_some()
+    }
+
+    /// Membrane strains `[ε_xx, ε_yy, γ_xy]` of every triangle in the warp frame.
+    pub fn triangle_strains(&self, x: &[DVec3]) -> Vec<[f64; 3]> {
+        self.rosettes.iter().map(|tri| rosette_strain(tri, x).0).collect()
+    }
+
+    /// Largest stretch ratio l/L over all edges (a blow-up shows as a huge value).
+    pub fn max_stretch(&self, x: &[DVec3]) -> f64 {
+        self.edges
+            .iter()
+            .map(|&[a, b]| {
+                let rest = (self.rest[a as usize] - self.rest[b as usize]).length();
+                (x[a as usize] - x[b as usize]).length() / rest
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Largest membrane tangent stiffness the material can reach, N/m.
+    pub fn max_membrane_stiffness(&self) -> f64 {
+        self.membrane_law.as_ref().map_or(0.0, |l| l.max_stiffness())
+    }
+}
+
+fn sorted_edge(a: u32, b: u32) -> [u32; 2] {
+    if a < b { [a, b] } else { [b, a] }
+}
+
+fn outer(a: DVec3, b: DVec3) -> DMat3 {
+    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}
+
+/// Edge k of a triangle runs from vertex k+1 to vertex k+2.
+fn edge_vertices(tri: &RosetteTriangle, k: usize) -> (u32, u32) {
+    (tri.vertices[(k + 1) % 3], tri.vertices[(k + 2) % 3])
+}
+
+/// Current rosette strains, unit edge directions and edge lengths.
+fn rosette_strain(tri: &RosetteTriangle, x: &[DVec3]) -> ([f64; 3], [DVec3; 3], [f64; 3]) {
+    let mut edge_strain = [0.0; 3];
+    let mut dirs = [DVec3::ZERO; 3];
+    let mut lengths = [0.0; 3];
+    for k in 0..3 {
+        let (a, b) = edge_vertices(tri, k);
+        let d = x[b as usize] - x[a as usize];
+        let l = d.length();
+        lengths[k] = l;
+        dirs[k] = if l > 0.0 { d / l } else { DVec3::ZERO };
+        edge_strain[k] = l / tri.rest_length[k] - 1.0;
+    }
+    let g = &tri.strain_from_edges;
+    let strain = [0, 1, 2].map(|i| g[i][0] * edge_strain[0] + g[i][1] * edge_strain[1] + g[i][2] * edge_strain[2]);
+    (strain, dirs, lengths)
+}
+
+/// Edge tensions ∂(Aψ)/∂l_k = A (T⁻ᵀ σ)_k / L_k, N.
+fn edge_tensions(tri: &RosetteTriangle, stress: [f64; 3]) -> [f64; 3] {
+    let g = &tri.strain_from_edges;
+    [0, 1, 2].map(|k| tri.area * (g[0][k] * stress[0] + g[1][k] * stress[1] + g[2][k] * stress[2]) / tri.rest_length[k])
+}
+
+fn rosette(mesh: &Mesh, t: usize, tri: [u32; 3], warp_angle: f64, pattern: &BlockCsr) -> RosetteTriangle {
+    let p = tri.map(|v| to_warp_frame(mesh.rest[v as usize], warp_angle));
+    let mut rows = [[0.0; 3]; 3];
+    let mut rest_length = [0.0; 3];
+    for k in 0..3 {
+        let d = p[(k + 2) % 3] - p[(k + 1) % 3];
+        let l = d.length();
+        rest_length[k] = l;
+        let (c, s) = (d.x / l, d.y / l);
+        // Strain gauge along the edge: ε_k = ε_xx c² + ε_yy s² + γ_xy c s.
+        rows[k] = [c * c, s * s, c * s];
+    }
+    let strain_from_edges = invert3(rows).expect("a non-degenerate triangle has three distinct edge directions");
+    let mut slots = [0u32; 9];
+    for a in 0..3 {
+        for b in 0..3 {
+            slots[a * 3 + b] = pattern.slot(tri[a], tri[b]) as u32;
+        }
+    }
+    RosetteTriangle { vertices: tri, area: mesh.signed_area(t), rest_length, strain_from_edges, slots }
+}
+
+fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+    let a = DMat3::from_cols_array_2d(&m).transpose();
+    let det = a.determinant();
+    if !det.is_finite() || det.abs() < 1e-14 {
+        return None;
+    }
+    Some(a.inverse().transpose().to_cols_array_2d())
+}
+
+/// Builds the constant bending matrix Q.
+///
+/// ```text
+///            w2                    Each triangle (a, b, c) with its three wing vertices
+///           /  \                   (across each edge) is a six-point patch. For edge k the
+///          c----b                  wing's deviation from the plane of the triangle,
+///         / \  / \                 s_k = Σ β_i x_i − x_w (β: the wing's barycentric
+///       w1   \/   w0               coordinates), is the paper's cantilever across that
+///             a                    edge; for a quadratic surface s_k = ½ tr(H M_k). The three
+///                                  equations give the surface Hessian H (x_,ij) on the
+///  triangle exactly for any quadratic, so the curvature is consistent on any triangulation.
+///  A free edge has no wing: its equation is the free-edge condition m_νν = 0 instead.
+/// ```
+/// For a nearly inextensible sheet bent from flat, x_,ij = II_ij n (Gauss's formula with a
+/// flat metric), so ψ_b = ½ D:II:II = ½ Σ D_ijkl x_,ij·x_,kl exactly: the energy is
+/// quadratic in positions and its Hessian is the constant Q (the anisotropic counterpart of
+/// Bergou et al.'s quadratic bending model). It is invariant to rigid motions, so the
+/// forces sum to zero and conserve momentum.
+fn bending_patches(mesh: &Mesh, warp_angle: f64, stiffness: &BendingStiffness) -> Result<Vec<BendingPatch>, ModelError> {
+    let mut edge_owner: HashMap<[u32; 2], Vec<(usize, usize)>> = HashMap::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            edge_owner.entry(sorted_edge(tri[(k + 1) % 3], tri[(k + 2) % 3])).or_default().push((t, k));
+        }
+    }
+    for (edge, owners) in &edge_owner {
+        if owners.len() > 2 {
+            return Err(MeshError::NonManifold { a: edge[0], b: edge[1] }.into());
+        }
+    }
+    let mut patches = Vec::with_capacity(mesh.triangles.len());
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let p = tri.map(|v| to_warp_frame(mesh.rest[v as usize], warp_angle));
+        let centroid = (p[0] + p[1] + p[2]) / 3.0;
+        let local = p.map(|q| q - centroid);
+        let mut rows = [[0.0; 3]; 3];
+        // coefficient of each patch vertex in each equation's right-hand side
+        let mut vertices: Vec<u32> = tri.to_vec();
+        let mut rhs: Vec<[f64; 3]> = vec![[0.0; 3]; 6];
+        for k in 0..3 {
+            let (ia, ib, ic) = ((k + 1) % 3, (k + 2) % 3, k);
+            let key = sorted_edge(tri[ia], tri[ib]);
+            let wing = edge_owner[&key].iter().find(|&&(other, _)| other != t).map(|&(other, ko)| mesh.triangles[other][ko]);
+            let row_scale;
+            match wing {
+                Some(w) => {
+                    let qw = to_warp_frame(mesh.rest[w as usize], warp_angle) - centroid;
+                    let beta = barycentric(qw, local[ia], local[ib], local[ic]);
+                    let m = |q: DVec2, s: f64| [s * q.x * q.x, s * q.y * q.y, s * q.x * q.y];
+                    let mut mk = [0.0; 3];
+                    for (q, s) in [(local[ia], beta[0]), (local[ib], beta[1]), (local[ic], beta[2]), (qw, -1.0)] {
+                        let e = m(q, s);
+                        for i in 0..3 {
+                            mk[i] += e[i];
+                        }
+                    }
+                    // ½ tr(H M) = ½ h_xx M_xx + ½ h_yy M_yy + h_xy M_xy.
+                    let row = [0.5 * mk[0], 0.5 * mk[1], mk[2]];
+                    row_scale = 1.0 / norm3(row);
+                    rows[k] = row.map(|v| v * row_scale);
+                    vertices.push(w);
+                    let wi = vertices.len() - 1;
+                    rhs[ia][k] = beta[0] * row_scale;
+                    rhs[ib][k] = beta[1] * row_scale;
+                    rhs[ic][k] = beta[2] * row_scale;
+                    rhs[wi][k] = -row_scale;
+                }
+                None => {
+                    let edge = local[ib] - local[ia];
+                    let normal = DVec2::new(edge.y, -edge.x).normalize(); // outward for a CCW triangle
+                    let row = stiffness.free_edge_row([normal.x, normal.y]);
+                    rows[k] = row.map(|v| v / norm3(row));
+                }
+            }
+        }
+        let inverse = invert3(rows).ok_or(ModelError::SingularBendingStencil { triangle: t })?;
+        // Weights W_a = Σ_k inverse[:, k] rhs[a][k]: H = Σ_a W_a x_a in Voigt order (xx, yy, xy).
+        let weights: Vec<[f64; 3]> = (0..vertices.len())
+            .map(|a| [0, 1, 2].map(|i| (0..3).map(|k| inverse[i][k] * rhs[a][k]).sum()))
+            .collect();
+        patches.push(BendingPatch { vertices, weights, area: mesh.signed_area(t) });
+    }
+    Ok(patches)
+}
+
+/// One triangle's bending stencil: its Hessian x_,ij in Voigt order (xx, yy, xy) is
+/// Σ_a weights[a] x_{vertices[a]}.
+#[derive(Debug, Clone)]
+struct BendingPatch {
+    vertices: Vec<u32>,
+    weights: Vec<[f64; 3]>,
+    /// Rest area, m².
+    area: f64,
+}
+
+impl BendingPatch {
+    fn hessian(&self, x: &[DVec3]) -> [DVec3; 3] {
+        let mut h = [DVec3::ZERO; 3];
+        for (v, w) in self.vertices.iter().zip(&self.weights) {
+            for i in 0..3 {
+                h[i] += w[i] * x[*v as usize];
+            }
+        }
+        h
+    }
+}
+
+/// Q = Σ_T A_T Wᵀ 𝔻 W, the constant Hessian of the quadratic bending energy.
+fn bending_matrix(n: usize, patches: &[BendingPatch], stiffness: &BendingStiffness) -> ScalarCsr {
+    let d = stiffness.voigt();
+    let pairs = patches.iter().flat_map(|p| {
+        p.vertices.iter().flat_map(move |&a| p.vertices.iter().map(move |&b| (a, b))).collect::<Vec<_>>()
+    });
+    let mut q = ScalarCsr::with_pattern(n, pairs);
+    for BendingPatch { vertices: vs, weights: ws, area } in patches {
+        for (a, wa) in vs.iter().zip(ws) {
+            for (b, wb) in vs.iter().zip(ws) {
+                let mut e = 0.0;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        e += wa[i] * d[i][j] * wb[j];
+                    }
+                }
+                let slot = q.slot(*a, *b);
+                q.values[slot] += area * e;
+            }
+        }
+    }
+    q
+}
+
+fn norm3(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+/// Barycentric coordinates of `p` with respect to the triangle (a, b, c).
+fn barycentric(p: DVec2, a: DVec2, b: DVec2, c: DVec2) -> [f64; 3] {
+    let area = (b - a).perp_dot(c - a);
+    let la = (b - p).perp_dot(c - p) / area;
+    let lb = (c - p).perp_dot(a - p) / area;
+    [la, lb, 1.0 - la - lb]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::curve::PiecewiseLinear;
+    use crate::sim::mesh::Pattern;
+
+    pub(crate) fn test_fabric() -> Fabric {
+        Fabric {
+            areal_density: 0.2,
+            thickness: 3e-4,
+            tensile_warp: PiecewiseLinear::new_material(&[[0.0, 0.0], [0.01, 10.0], [0.05, 200.0]]).unwrap(),
+            tensile_weft: PiecewiseLinear::new_material(&[[0.0, 0.0], [0.02, 12.0], [0.06, 150.0]]).unwrap(),
+            shear_modulus: 30.0,
+            poisson_warp: 0.2,
+            bending_warp: 1.2e-5,
+            bending_weft: 0.8e-5,
+            bending_bias: None,
+        }
+    }
+
+    fn deformed(model: &Model, f: impl Fn(DVec2) -> DVec3) -> Vec<DVec3> {
+        model.rest.iter().map(|&p| f(p)).collect()
+    }
+
+    #[test]
+    fn forces_are_minus_the_energy_gradient() {
+        for pattern in [Pattern::Alternating, Pattern::Jittered] {
+            let mesh = Mesh::rectangle(0.04, 0.03, 0.01, pattern, 3).unwrap();
+            let model = Model::new(&mesh, &test_fabric(), 0.4, PhysicsOptions::default()).unwrap();
+            let x = deformed(&model, |p| {
+                DVec3::new(p.x * 1.02 + 0.003 * p.y, p.y * 0.99, 0.2 * p.x * p.x + 0.1 * p.x * p.y + 0.001 * (p.y * 300.0).sin())
+            });
+            let mut f = vec![DVec3::ZERO; x.len()];
+            model.forces(&x, &mut f);
+            let h = 1e-7;
+            for v in [0, 5, 11, x.len() - 1] {
+                for c in 0..3 {
+                    let mut xp = x.clone();
+                    let mut xm = x.clone();
+                    xp[v][c] += h;
+                    xm[v][c] -= h;
+                    let numeric = -(model.potential_energy(&xp) - model.potential_energy(&xm)) / (2.0 * h);
+                    let scale = f.iter().map(|q| q.length()).fold(0.0, f64::max);
+                    assert!((numeric - f[v][c]).abs() < 1e-5 * scale, "{pattern:?} v{v} c{c}: {numeric} vs {}", f[v][c]);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn stiffness_matches_force_derivative_in_tension() {
+        let mesh = Mesh::rectangle(0.03, 0.02, 0.01, Pattern::Regular, 0).unwrap();
+        let opts = PhysicsOptions { bending: false, gravity: DVec3::ZERO, ..Default::default() };
+        let model = Model::new(&mesh, &test_fabric(), 0.0, opts).unwrap();
+        // Biaxial stretch along the warp and weft of a right-triangle grid: no edge carries
+        // compression, so the projected Hessian equals the exact one.
+        let x = deformed(&model, |p| DVec3::new(1.03 * p.x, 1.025 * p.y, 0.0));
+        let mut k = model.stiffness_matrix();
+        model.assemble_membrane_stiffness(&x, &mut k);
+        let direction: Vec<DVec3> = (0..x.len()).map(|i| DVec3::new((i as f64).sin(), (i as f64 * 0.7).cos(), 0.3)).collect();
+        let mut kd = vec![DVec3::ZERO; x.len()];
+        k.multiply(&direction, &mut kd);
+        let h = 1e-8;
+        let xp: Vec<DVec3> = x.iter().zip(&direction).map(|(a, d)| *a + h * *d).collect();
+        let xm: Vec<DVec3> = x.iter().zip(&direction).map(|(a, d)| *a - h * *d).collect();
+        let (mut fp, mut fm) = (vec![DVec3::ZERO; x.len()], vec![DVec3::ZERO; x.len()]);
+        model.forces(&xp, &mut fp);
+        model.forces(&xm, &mut fm);
+        for i in 0..x.len() {
+            let numeric = -(fp[i] - fm[i]) / (2.0 * h);
+            assert!((numeric - kd[i]).length() < 1e-4 * (1.0 + kd[i].length()), "vertex {i}: {numeric} vs {}", kd[i]);
+        }
+    }
+
+    #[test]
+    fn rigid_motion_costs_no_energy() {
+        let mesh = Mesh::rectangle(0.05, 0.03, 0.01, Pattern::Equilateral, 0).unwrap();
+        let opts = PhysicsOptions { gravity: DVec3::ZERO, ..Default::default() };
+        let model = Model::new(&mesh, &test_fabric(), 0.7, opts).unwrap();
+        let rotation = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0);
+        let x = deformed(&model, |p| rotation * DVec3::new(p.x, p.y, 0.0) + DVec3::new(1.0, -2.0, 0.5));
+        let (membrane, bending) = model.elastic_energy(&x);
+        // Round-off only: a strain of 1e-6 alone would store about 1e-12 J here.
+        assert!(membrane.abs() < 1e-13, "{membrane}");
+        assert!(bending.abs() < 1e-13, "{bending}");
+    }
+
+    /// A cylindrical bend of curvature κ in direction θ stores ½ B_θ κ² per unit area
+    /// (eq. 3). The discrete energy must converge to it on every triangulation and warp angle.
+    #[test]
+    fn cylindrical_bending_energy_converges_to_eq3() {
+        let fabric = test_fabric();
+        let opts = PhysicsOptions { membrane: false, gravity: DVec3::ZERO, ..Default::default() };
+        let kappa = 8.0;
+        for pattern in [Pattern::Regular, Pattern::Alternating, Pattern::Equilateral, Pattern::Jittered] {
+            for (warp_deg, bend_deg) in [(0.0, 0.0), (30.0, 0.0), (0.0, 90.0), (45.0, 20.0)] {
+                let mut errors = Vec::new();
+                for h in [0.01, 0.005] {
+                    let mesh = Mesh::rectangle(0.1, 0.1, h, pattern, 11).unwrap();
+                    let model = Model::new(&mesh, &fabric, f64::to_radians(warp_deg), opts).unwrap();
+                    let dir = DVec2::from_angle(f64::to_radians(bend_deg));
+                    // Isometric roll: arclength s along `dir` wraps onto a circle of radius 1/κ.
+                    let x = deformed(&model, |p| {
+                        let s = p.dot(dir);
+                        let t = p.dot(dir.perp());
+                        let along = dir * ((kappa * s).sin() / kappa) + dir.perp() * t;
+                        DVec3::new(along.x, along.y, (1.0 - (kappa * s).cos()) / kappa)
+                    });
+                    // Free edges carry no moment (m_νν = 0), which a uniform roll violates,
+                    // so compare on the triangles that have all three neighbours.
+                    let energies = model.triangle_bending_energies(&x);
+                    let interior: Vec<usize> = (0..energies.len()).filter(|&t| model.is_interior_triangle(t)).collect();
+                    let bending: f64 = interior.iter().map(|&t| energies[t]).sum();
+                    let area: f64 = interior.iter().map(|&t| mesh.signed_area(t)).sum();
+                    let theta = f64::to_radians(bend_deg - warp_deg);
+                    let exact = 0.5 * model.bending_stiffness.rigidity_at(theta) * kappa * kappa * area;
+                    errors.push(((bending - exact) / exact).abs());
+                }
+                assert!(errors[1] < 0.01, "{pattern:?} warp {warp_deg} bend {bend_deg}: errors {errors:?}");
+                assert!(errors[1] <= errors[0] + 1e-4, "{pattern:?}: error must not grow on refinement {errors:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,264 @@
+//! Sparse symmetric matrices over vertices and the preconditioned conjugate gradient.
+//!
+//! Written by hand rather than taken from a general sparse crate because the structure is
+//! fixed for a whole run: the pattern is built once from the mesh, each element keeps the
+//! slots it writes to, and re-assembly is a plain pass over a value array. The in-plane
+//! part is stored as 3×3 blocks; the bending part is a scalar matrix that acts the same on
+//! x, y and z (its energy is ½ Σ Q_ab x_a·x_b), so it is stored once, not three times.
+
+use glam::{DMat3, DVec3};
+
+/// Compressed sparse rows of 3×3 blocks with a fixed pattern.
+#[derive(Debug, Clone)]
+pub struct BlockCsr {
+    row_start: Vec<u32>,
+    cols: Vec<u32>,
+    pub values: Vec<DMat3>,
+}
+
+/// Compressed sparse rows of scalars with a fixed pattern.
+#[derive(Debug, Clone)]
+pub struct ScalarCsr {
+    row_start: Vec<u32>,
+    cols: Vec<u32>,
+    pub values: Vec<f64>,
+}
+
+/// Sorted, de-duplicated column lists per row, from (row, col) pairs, symmetric and with diagonals.
+fn pattern(n: usize, pairs: impl Iterator<Item = (u32, u32)>) -> (Vec<u32>, Vec<u32>) {
+    let mut rows: Vec<Vec<u32>> = (0..n as u32).map(|i| vec![i]).collect();
+    for (a, b) in pairs {
+        rows[a as usize].push(b);
+        rows[b as usize].push(a);
+    }
+    let mut row_start = Vec::with_capacity(n + 1);
+    let mut cols = Vec::new();
+    row_start.push(0);
+    for mut row in rows {
+        row.sort_unstable();
+        row.dedup();
+        cols.extend_from_slice(&row);
+        row_start.push(cols.len() as u32);
+    }
+    (row_start, cols)
+}
+
+fn find_slot(row_start: &[u32], cols: &[u32], row: u32, col: u32) -> usize {
+    let (s, e) = (row_start[row as usize] as usize, row_start[row as usize + 1] as usize);
+    s + cols[s..e].binary_search(&col).expect("entry must be in the sparsity pattern")
+}
+
+impl BlockCsr {
+    /// A zero matrix over `n` vertices whose pattern holds every pair given (and its transpose).
+    pub fn with_pattern(n: usize, pairs: impl Iterator<Item = (u32, u32)>) -> Self {
+        let (row_start, cols) = pattern(n, pairs);
+        let values = vec![DMat3::ZERO; cols.len()];
+        Self { row_start, cols, values }
+    }
+
+    /// Index into `values` of block (row, col). Build-time only: a binary search.
+    pub fn slot(&self, row: u32, col: u32) -> usize {
+        find_slot(&self.row_start, &self.cols, row, col)
+    }
+
+    pub fn diagonal_slot(&self, row: u32) -> usize {
+        self.slot(row, row)
+    }
+
+    pub fn clear(&mut self) {
+        self.values.fill(DMat3::ZERO);
+    }
+
+    /// y = A x (y overwritten).
+    pub fn multiply(&self, x: &[DVec3], y: &mut [DVec3]) {
+        for (row, out) in y.iter_mut().enumerate() {
+            let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
+            let mut acc = DVec3::ZERO;
+            for k in s..e {
+                acc += self.values[k] * x[self.cols[k] as usize];
+            }
+            *out = acc;
+        }
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.row_start.len() - 1
+    }
+}
+
+impl ScalarCsr {
+    pub fn with_pattern(n: usize, pairs: impl Iterator<Item = (u32, u32)>) -> Self {
+        let (row_start, cols) = pattern(n, pairs);
+        let values = vec![0.0; cols.len()];
+        Self { row_start, cols, values }
+    }
+
+    pub fn slot(&self, row: u32, col: u32) -> usize {
+        find_slot(&self.row_start, &self.cols, row, col)
+    }
+
+    /// y += A x, the scalar matrix acting on each coordinate.
+    pub fn multiply_add(&self, x: &[DVec3], y: &mut [DVec3]) {
+        for (row, out) in y.iter_mut().enumerate() {
+            let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
+            let mut acc = DVec3::ZERO;
+            for k in s..e {
+                acc += self.values[k] * x[self.cols[k] as usize];
+            }
+            *out += acc;
+        }
+    }
+
+    pub fn diagonal(&self, row: u32) -> f64 {
+        self.values[self.slot(row, row)]
+    }
+
+    /// Drops entries that are zero (a pattern built generously, then trimmed once).
+    pub fn prune(self) -> Self {
+        let mut row_start = vec![0u32];
+        let mut cols = Vec::new();
+        let mut values = Vec::new();
+        for row in 0..self.row_start.len() - 1 {
+            for k in self.row_start[row] as usize..self.row_start[row + 1] as usize {
+                if self.values[k] != 0.0 || self.cols[k] as usize == row {
+                    cols.push(self.cols[k]);
+                    values.push(self.values[k]);
+                }
+            }
+            row_start.push(cols.len() as u32);
+        }
+        Self { row_start, cols, values }
+    }
+
+    /// Iterates the stored entries as (row, col, value).
+    pub fn entries(&self) -> impl Iterator<Item = (u32, u32, f64)> + '_ {
+        (0..self.row_start.len() - 1).flat_map(move |row| {
+            (self.row_start[row] as usize..self.row_start[row + 1] as usize)
+                .map(move |k| (row as u32, self.cols[k], self.values[k]))
+        })
+    }
+}
+
+/// The Newton system matrix `A = diag(mass_diagonal) + K + Q ⊗ I₃`, with fixed vertices removed.
+pub struct SystemMatrix<'a> {
+    pub mass_diagonal: &'a [f64],
+    pub stiffness: &'a BlockCsr,
+    pub bending: Option<&'a ScalarCsr>,
+    /// `true` for vertices whose positions are prescribed (their rows and columns are dropped).
+    pub fixed: &'a [bool],
+}
+
+impl SystemMatrix<'_> {
+    fn apply(&self, x: &[DVec3], y: &mut [DVec3]) {
+        self.stiffness.multiply(x, y);
+        if let Some(q) = self.bending {
+            q.multiply_add(x, y);
+        }
+        for i in 0..y.len() {
+            y[i] = if self.fixed[i] { DVec3::ZERO } else { y[i] + self.mass_diagonal[i] * x[i] };
+        }
+    }
+
+    /// Inverse 3×3 diagonal blocks: the block-Jacobi preconditioner.
+    fn block_jacobi(&self) -> Vec<DMat3> {
+        (0..self.fixed.len())
+            .map(|i| {
+                if self.fixed[i] {
+                    return DMat3::ZERO;
+                }
+                let q = self.bending.map_or(0.0, |q| q.diagonal(i as u32));
+                let block = self.stiffness.values[self.stiffness.diagonal_slot(i as u32)]
+                    + DMat3::from_diagonal(DVec3::splat(self.mass_diagonal[i] + q));
+                block.inverse()
+            })
+            .collect()
+    }
+}
+
+/// Outcome of a conjugate-gradient solve.
+#[derive(Debug, Clone, Copy)]
+pub struct CgReport {
+    pub iterations: usize,
+    pub relative_residual: f64,
+}
+
+fn dot(a: &[DVec3], b: &[DVec3]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum()
+}
+
+/// Solves `A x = b` by preconditioned conjugate gradients from `x = 0`, to a residual of
+/// `tolerance · |b|`. `A` must be symmetric positive definite on the free vertices.
+pub fn pcg(a: &SystemMatrix, b: &[DVec3], x: &mut [DVec3], tolerance: f64, max_iterations: usize) -> CgReport {
+    let n = b.len();
+    let preconditioner = a.block_jacobi();
+    x.fill(DVec3::ZERO);
+    let mut r: Vec<DVec3> = b.iter().zip(a.fixed).map(|(&v, &f)| if f { DVec3::ZERO } else { v }).collect();
+    let b_norm = dot(&r, &r).sqrt();
+    if b_norm == 0.0 {
+        return CgReport { iterations: 0, relative_residual: 0.0 };
+    }
+    let mut z: Vec<DVec3> = (0..n).map(|i| preconditioner[i] * r[i]).collect();
+    let mut p = z.clone();
+    let mut ap = vec![DVec3::ZERO; n];
+    let mut rz = dot(&r, &z);
+    let mut iterations = 0;
+    let mut residual = 1.0;
+    while iterations < max_iterations {
+        a.apply(&p, &mut ap);
+        let pap = dot(&p, &ap);
+        if pap <= 0.0 || !pap.is_finite() {
+            break;
+        }
+        let alpha = rz / pap;
+        for i in 0..n {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * ap[i];
+        }
+        iterations += 1;
+        residual = dot(&r, &r).sqrt() / b_norm;
+        if residual <= tolerance {
+            break;
+        }
+        for i in 0..n {
+            z[i] = preconditioner[i] * r[i];
+        }
+        let rz_next = dot(&r, &z);
+        let beta = rz_next / rz;
+        rz = rz_next;
+        for i in 0..n {
+            p[i] = z[i] + beta * p[i];
+        }
+    }
+    CgReport { iterations, relative_residual: residual }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pcg_solves_a_small_spd_system() {
+        // A chain of three vertices coupled by springs along x plus a mass term.
+        let mut k = BlockCsr::with_pattern(3, [(0, 1), (1, 2)].into_iter());
+        let spring = DMat3::from_diagonal(DVec3::new(2.0, 1.0, 0.5));
+        for (a, b) in [(0u32, 1u32), (1, 2)] {
+            let (aa, bb, ab, ba) = (k.slot(a, a), k.slot(b, b), k.slot(a, b), k.slot(b, a));
+            k.values[aa] += spring;
+            k.values[bb] += spring;
+            k.values[ab] -= spring;
+            k.values[ba] -= spring;
+        }
+        let mass = [1.0, 2.0, 3.0];
+        let fixed = [false; 3];
+        let a = SystemMatrix { mass_diagonal: &mass, stiffness: &k, bending: None, fixed: &fixed };
+        let b = vec![DVec3::new(1.0, 0.0, 2.0), DVec3::new(-1.0, 3.0, 0.0), DVec3::new(0.5, 0.5, 0.5)];
+        let mut x = vec![DVec3::ZERO; 3];
+        let report = pcg(&a, &b, &mut x, 1e-12, 100);
+        assert!(report.relative_residual < 1e-12);
+        let mut ax = vec![DVec3::ZERO; 3];
+        a.apply(&x, &mut ax);
+        for i in 0..3 {
+            assert!((ax[i] - b[i]).length() < 1e-10);
+        }
+    }
+}
