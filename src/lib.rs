@@ -1,2 +1,6 @@
-//! Rosette: a woven-fabric simulator.
+//! Rosette: a woven-fabric simulator and virtual fabric laboratory.
+//!
+//! `sim` is the physics (no I/O); `scene` turns presets into runnable laboratory tests
+//! with measurements; the `rosette` binary drives scenes from the command line.
+pub mod scene;
 pub mod sim;

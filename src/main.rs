@@ -1,1 +1,130 @@
-fn main() {}
+//! The `rosette` command: runs bundled or custom scenes headless and reports metrics.
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use rosette::scene::{RunOptions, Scene, load_scene, preset, run_scene};
+use std::io::{IsTerminal, Write};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "rosette", version, about = "Woven-fabric simulator and virtual fabric laboratory")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scene headless and report its measurements.
+    Run {
+        /// A bundled scene name (see `rosette presets`) or the path of a scene file.
+        preset: String,
+        /// Override a preset value, e.g. --set fabric.areal_density=0.2 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<String>,
+        /// Simulated seconds (default: the scene's scene.duration).
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Write the metrics JSON to FILE, or to standard output with '-'.
+        #[arg(long, value_name = "FILE|-")]
+        metrics: Option<String>,
+    },
+    /// List the bundled scenes.
+    Presets,
+}
+
+/// Exit codes: 0 done, 2 bad input, 3 the simulation diverged.
+const EXIT_BAD_INPUT: u8 = 2;
+const EXIT_DIVERGED: u8 = 3;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Presets => {
+            for (name, description) in preset::scene_descriptions() {
+                println!("{name:<16} {description}");
+            }
+            ExitCode::SUCCESS
+        }
+        Command::Run { preset, overrides, duration, metrics } => run(&preset, &overrides, duration, metrics.as_deref()),
+    }
+}
+
+fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Option<&str>) -> ExitCode {
+    let config = match load_scene(spec, overrides) {
+        Ok((config, _)) => config,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    if let Some(d) = duration {
+        if !(d.is_finite() && d > 0.0) {
+            eprintln!("error: --duration must be a positive number of seconds, got {d}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    }
+    let mut scene = match Scene::build(config) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {spec}: {e}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let name = std::path::Path::new(spec).file_stem().map_or(spec.to_string(), |s| s.to_string_lossy().into_owned());
+    // A progress bar only where someone watches, and only if the run lasts.
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(1000);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% ({elapsed}, eta {eta})")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_message(name.clone());
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+        bar
+    });
+    let started = std::time::Instant::now();
+    let mut on_progress = |fraction: f64| {
+        if let Some(bar) = &bar {
+            if bar.is_hidden() && started.elapsed().as_secs_f64() > 1.0 {
+                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            }
+            bar.set_position((fraction * 1000.0) as u64);
+        }
+    };
+    let (metrics, error) = run_scene(&mut scene, &name, RunOptions { duration, progress: Some(&mut on_progress) });
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    if let Err(e) = write_metrics(&metrics, metrics_out) {
+        eprintln!("error: {e:#}");
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
+    if metrics_out.is_none() {
+        eprintln!(
+            "{name}: {} steps of {} s with {}, {:.3} s simulated in {:.2} s wall ({:.4} CPU s per 10 ms simulated)",
+            metrics.steps, metrics.dt, metrics.integrator, metrics.simulated_seconds, metrics.wall_seconds, metrics.cpu_seconds_per_10ms
+        );
+        println!("{}", serde_json::to_string_pretty(&metrics.measures).expect("JSON values serialise"));
+    }
+    match error {
+        Some(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(EXIT_DIVERGED)
+        }
+        None => ExitCode::SUCCESS,
+    }
+}
+
+fn write_metrics(metrics: &rosette::scene::Metrics, out: Option<&str>) -> anyhow::Result<()> {
+    let Some(out) = out else { return Ok(()) };
+    let text = serde_json::to_string_pretty(metrics)?;
+    if out == "-" {
+        let mut stdout = std::io::stdout().lock();
+        writeln!(stdout, "{text}")?;
+    } else {
+        std::fs::write(out, text + "\n").with_context(|| format!("cannot write metrics to {out}"))?;
+    }
+    Ok(())
+}

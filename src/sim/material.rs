@@ -240,13 +240,6 @@ impl BendingStiffness {
     pub fn voigt(&self) -> [[f64; 3]; 3] {
         [[self.d11, self.d12, 0.0], [self.d12, self.d22, 0.0], [0.0, 0.0, 4.0 * self.d66]]
     }
-
-    /// Row of the free-edge condition m_νν = 0 in the unknowns `[κ_xx, κ_yy, κ_xy]`, for an
-    /// edge with unit outward normal `n` in the warp frame (m_xy = 2 D66 κ_xy).
-    pub fn free_edge_row(&self, n: [f64; 2]) -> [f64; 3] {
-        let (nx2, ny2, nxy) = (n[0] * n[0], n[1] * n[1], n[0] * n[1]);
-        [nx2 * self.d11 + ny2 * self.d12, nx2 * self.d12 + ny2 * self.d22, 2.0 * nxy * 2.0 * self.d66]
-    }
 }
 
 #[cfg(test)]

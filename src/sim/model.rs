@@ -163,7 +163,7 @@ impl Model {
         };
         let bending_stiffness = BendingStiffness::new(fabric)?;
         let (bending, bending_patches) = if options.bending {
-            let patches = bending_patches(mesh, warp_angle, &bending_stiffness)?;
+            let patches = bending_patches(mesh, warp_angle)?;
             (Some(bending_matrix(n, &patches, &bending_stiffness)), patches)
         } else {
             (None, Vec::new())
@@ -419,7 +419,7 @@ impl Model {
 
     /// Whether triangle `t` has a neighbour across each of its edges.
     pub fn is_interior_triangle(&self, t: usize) -> bool {
-        self.bending_patches.get(t).is_some_and(|p| p.vertices.len() == 6)
+        self.bending_patches.get(t).is_some_and(|p| p.interior)
     }
 
     pub fn has_membrane(&self) -> bool {
@@ -516,29 +516,36 @@ fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     Some(a.inverse().transpose().to_cols_array_2d())
 }
 
-/// Builds the constant bending matrix Q.
+/// Builds every triangle's bending stencil: its surface Hessian x_,ij as a linear
+/// combination of nearby vertex positions.
 ///
 /// ```text
-///            w2                    Each triangle (a, b, c) with its three wing vertices
-///           /  \                   (across each edge) is a six-point patch. For edge k the
-///          c----b                  wing's deviation from the plane of the triangle,
-///         / \  / \                 s_k = Σ β_i x_i − x_w (β: the wing's barycentric
-///       w1   \/   w0               coordinates), is the paper's cantilever across that
-///             a                    edge; for a quadratic surface s_k = ½ tr(H M_k). The three
-///                                  equations give the surface Hessian H (x_,ij) on the
-///  triangle exactly for any quadratic, so the curvature is consistent on any triangulation.
-///  A free edge has no wing: its equation is the free-edge condition m_νν = 0 instead.
+///        c                The curvature of triangle T is the divergence form
+///       / \               H_T = (1/A_T) Σ_k L_k sym(n_k ⊗ G_k) = (1/A_T) ∫_T ∇∇x,
+///   G1 •   • G0           with n_k the outward normal of edge k and G_k the gradient
+///     /     \             ∇x at edge k's midpoint, estimated by a least-squares
+///    a---•---b            quadratic fit over the vertices around that edge (the
+///        G2               wings across it: the paper's cantilevers across the edge).
 /// ```
+/// Two properties make it converge on any triangulation: the fit is exact for quadratic
+/// surfaces, so H_T is exact for any constant curvature; and both triangles of an edge use
+/// the same G_k, so Σ_T A_T H_T telescopes to boundary terms and a uniformly curved sheet is
+/// in equilibrium away from its edges (the finite-element patch test). A per-triangle fit
+/// without the shared edge gradients fails the second and is twice too soft on some meshes.
+///
 /// For a nearly inextensible sheet bent from flat, x_,ij = II_ij n (Gauss's formula with a
-/// flat metric), so ψ_b = ½ D:II:II = ½ Σ D_ijkl x_,ij·x_,kl exactly: the energy is
-/// quadratic in positions and its Hessian is the constant Q (the anisotropic counterpart of
-/// Bergou et al.'s quadratic bending model). It is invariant to rigid motions, so the
-/// forces sum to zero and conserve momentum.
-fn bending_patches(mesh: &Mesh, warp_angle: f64, stiffness: &BendingStiffness) -> Result<Vec<BendingPatch>, ModelError> {
+/// flat metric), so ψ_b = ½ D:II:II = ½ Σ D_ijkl x_,ij·x_,kl: the energy is quadratic in
+/// positions and its Hessian is a constant matrix Q (the anisotropic counterpart of Bergou et
+/// al.'s quadratic bending model). It is invariant to rigid motions, so the forces sum to
+/// zero and conserve momentum.
+fn bending_patches(mesh: &Mesh, warp_angle: f64) -> Result<Vec<BendingPatch>, ModelError> {
+    let n = mesh.rest.len();
     let mut edge_owner: HashMap<[u32; 2], Vec<(usize, usize)>> = HashMap::new();
+    let mut vertex_triangles: Vec<Vec<u32>> = vec![Vec::new(); n];
     for (t, tri) in mesh.triangles.iter().enumerate() {
         for k in 0..3 {
             edge_owner.entry(sorted_edge(tri[(k + 1) % 3], tri[(k + 2) % 3])).or_default().push((t, k));
+            vertex_triangles[tri[k] as usize].push(t as u32);
         }
     }
     for (edge, owners) in &edge_owner {
@@ -546,59 +553,140 @@ fn bending_patches(mesh: &Mesh, warp_angle: f64, stiffness: &BendingStiffness) -
             return Err(MeshError::NonManifold { a: edge[0], b: edge[1] }.into());
         }
     }
+    let warp: Vec<DVec2> = mesh.rest.iter().map(|&p| to_warp_frame(p, warp_angle)).collect();
+    let scale = mesh.mean_edge_length();
+    // One gradient stencil per edge, shared by its triangles.
+    let mut gradient_of_edge: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
+    for (&edge, owners) in &edge_owner {
+        let midpoint = 0.5 * (warp[edge[0] as usize] + warp[edge[1] as usize]);
+        let stencil = edge_gradient_stencil(mesh, &vertex_triangles, &warp, edge, midpoint, scale)
+            .ok_or(ModelError::SingularBendingStencil { triangle: owners[0].0 })?;
+        gradient_of_edge.insert(edge, stencil);
+    }
     let mut patches = Vec::with_capacity(mesh.triangles.len());
     for (t, tri) in mesh.triangles.iter().enumerate() {
-        let p = tri.map(|v| to_warp_frame(mesh.rest[v as usize], warp_angle));
-        let centroid = (p[0] + p[1] + p[2]) / 3.0;
-        let local = p.map(|q| q - centroid);
-        let mut rows = [[0.0; 3]; 3];
-        // coefficient of each patch vertex in each equation's right-hand side
-        let mut vertices: Vec<u32> = tri.to_vec();
-        let mut rhs: Vec<[f64; 3]> = vec![[0.0; 3]; 6];
+        let area = mesh.signed_area(t);
+        let mut weights: Vec<(u32, [f64; 3])> = Vec::new();
+        let mut interior = true;
         for k in 0..3 {
-            let (ia, ib, ic) = ((k + 1) % 3, (k + 2) % 3, k);
-            let key = sorted_edge(tri[ia], tri[ib]);
-            let wing = edge_owner[&key].iter().find(|&&(other, _)| other != t).map(|&(other, ko)| mesh.triangles[other][ko]);
-            let row_scale;
-            match wing {
-                Some(w) => {
-                    let qw = to_warp_frame(mesh.rest[w as usize], warp_angle) - centroid;
-                    let beta = barycentric(qw, local[ia], local[ib], local[ic]);
-                    let m = |q: DVec2, s: f64| [s * q.x * q.x, s * q.y * q.y, s * q.x * q.y];
-                    let mut mk = [0.0; 3];
-                    for (q, s) in [(local[ia], beta[0]), (local[ib], beta[1]), (local[ic], beta[2]), (qw, -1.0)] {
-                        let e = m(q, s);
-                        for i in 0..3 {
-                            mk[i] += e[i];
-                        }
-                    }
-                    // ½ tr(H M) = ½ h_xx M_xx + ½ h_yy M_yy + h_xy M_xy.
-                    let row = [0.5 * mk[0], 0.5 * mk[1], mk[2]];
-                    row_scale = 1.0 / norm3(row);
-                    rows[k] = row.map(|v| v * row_scale);
-                    vertices.push(w);
-                    let wi = vertices.len() - 1;
-                    rhs[ia][k] = beta[0] * row_scale;
-                    rhs[ib][k] = beta[1] * row_scale;
-                    rhs[ic][k] = beta[2] * row_scale;
-                    rhs[wi][k] = -row_scale;
-                }
-                None => {
-                    let edge = local[ib] - local[ia];
-                    let normal = DVec2::new(edge.y, -edge.x).normalize(); // outward for a CCW triangle
-                    let row = stiffness.free_edge_row([normal.x, normal.y]);
-                    rows[k] = row.map(|v| v / norm3(row));
+            let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            let key = sorted_edge(a, b);
+            interior &= edge_owner[&key].len() == 2;
+            let edge = warp[b as usize] - warp[a as usize];
+            // Outward normal times edge length, for a counter-clockwise triangle.
+            let ln = DVec2::new(edge.y, -edge.x);
+            for &(v, c) in &gradient_of_edge[&key] {
+                let w = [ln.x * c.x / area, ln.y * c.y / area, 0.5 * (ln.x * c.y + ln.y * c.x) / area];
+                match weights.iter_mut().find(|(u, _)| *u == v) {
+                    Some((_, acc)) => (0..3).for_each(|i| acc[i] += w[i]),
+                    None => weights.push((v, w)),
                 }
             }
         }
-        let inverse = invert3(rows).ok_or(ModelError::SingularBendingStencil { triangle: t })?;
-        // Weights W_a = Σ_k inverse[:, k] rhs[a][k]: H = Σ_a W_a x_a in Voigt order (xx, yy, xy).
-        let weights: Vec<[f64; 3]> = (0..vertices.len())
-            .map(|a| [0, 1, 2].map(|i| (0..3).map(|k| inverse[i][k] * rhs[a][k]).sum()))
-            .collect();
-        patches.push(BendingPatch { vertices, weights, area: mesh.signed_area(t) });
+        let (vertices, weights) = weights.into_iter().unzip();
+        patches.push(BendingPatch { vertices, weights, area, interior });
     }
     Ok(patches)
+}
+
+/// Weights c_v (2-vectors) such that Σ_v c_v f_v is the gradient at `midpoint` of the
+/// least-squares quadratic through the values f_v at the vertices around `edge`; exact for
+/// quadratics. The neighbourhood grows ring by ring until the fit is well posed (near
+/// corners one ring lies on two lines, which no quadratic fit can resolve).
+fn edge_gradient_stencil(
+    mesh: &Mesh,
+    vertex_triangles: &[Vec<u32>],
+    warp: &[DVec2],
+    edge: [u32; 2],
+    midpoint: DVec2,
+    scale: f64,
+) -> Option<Vec<(u32, DVec2)>> {
+    let mut points: Vec<u32> = edge.to_vec();
+    for _ring in 0..3 {
+        let mut grown = points.clone();
+        for &v in &points {
+            for &t in &vertex_triangles[v as usize] {
+                grown.extend_from_slice(&mesh.triangles[t as usize]);
+            }
+        }
+        grown.sort_unstable();
+        grown.dedup();
+        points = grown;
+        if let Some(stencil) = quadratic_gradient_weights(&points, warp, midpoint, scale) {
+            return Some(stencil);
+        }
+    }
+    None
+}
+
+/// Least-squares fit of f ≈ c0 + c1 u + c2 v + c3 u² + c4 uv + c5 v² with (u, v) the
+/// offsets from `midpoint` over `scale`, weighted towards near points; returns the weights
+/// of each point's value in (c1, c2)/scale. None if the fit is ill-posed.
+fn quadratic_gradient_weights(points: &[u32], warp: &[DVec2], midpoint: DVec2, scale: f64) -> Option<Vec<(u32, DVec2)>> {
+    if points.len() < 6 {
+        return None;
+    }
+    let rows: Vec<([f64; 6], f64)> = points
+        .iter()
+        .map(|&v| {
+            let d = (warp[v as usize] - midpoint) / scale;
+            // Near points count more, so the fit is as local as the data allow.
+            let weight = 1.0 / (1.0 + d.length_squared());
+            ([1.0, d.x, d.y, d.x * d.x, d.x * d.y, d.y * d.y], weight)
+        })
+        .collect();
+    let mut normal = [[0.0f64; 6]; 6];
+    for (r, w) in &rows {
+        for i in 0..6 {
+            for j in 0..6 {
+                normal[i][j] += w * r[i] * r[j];
+            }
+        }
+    }
+    let inverse = invert_spd6(normal)?;
+    Some(
+        points
+            .iter()
+            .zip(&rows)
+            .map(|(&v, (r, w))| {
+                let coefficient = |row: usize| (0..6).map(|j| inverse[row][j] * r[j]).sum::<f64>() * w;
+                (v, DVec2::new(coefficient(1), coefficient(2)) / scale)
+            })
+            .collect(),
+    )
+}
+
+/// Inverse of a symmetric positive definite 6×6 matrix by Cholesky; None when a pivot is
+/// tiny relative to the diagonal (an ill-posed fit).
+fn invert_spd6(a: [[f64; 6]; 6]) -> Option<[[f64; 6]; 6]> {
+    let mut l = [[0.0f64; 6]; 6];
+    let largest = (0..6).map(|i| a[i][i]).fold(0.0, f64::max);
+    for i in 0..6 {
+        for j in 0..=i {
+            let s = a[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
+            if i == j {
+                if s <= 1e-9 * largest {
+                    return None;
+                }
+                l[i][i] = s.sqrt();
+            } else {
+                l[i][j] = s / l[j][j];
+            }
+        }
+    }
+    let mut inverse = [[0.0f64; 6]; 6];
+    for col in 0..6 {
+        // Solve L y = e_col, then Lᵀ x = y.
+        let mut y = [0.0f64; 6];
+        for i in 0..6 {
+            let rhs = if i == col { 1.0 } else { 0.0 };
+            y[i] = (rhs - (0..i).map(|k| l[i][k] * y[k]).sum::<f64>()) / l[i][i];
+        }
+        for i in (0..6).rev() {
+            inverse[i][col] = (y[i] - (i + 1..6).map(|k| l[k][i] * inverse[k][col]).sum::<f64>()) / l[i][i];
+        }
+    }
+    Some(inverse)
 }
 
 /// One triangle's bending stencil: its Hessian x_,ij in Voigt order (xx, yy, xy) is
@@ -609,6 +697,8 @@ struct BendingPatch {
     weights: Vec<[f64; 3]>,
     /// Rest area, m².
     area: f64,
+    /// Whether the triangle has a neighbour across each edge.
+    interior: bool,
 }
 
 impl BendingPatch {
@@ -630,7 +720,7 @@ fn bending_matrix(n: usize, patches: &[BendingPatch], stiffness: &BendingStiffne
         p.vertices.iter().flat_map(move |&a| p.vertices.iter().map(move |&b| (a, b))).collect::<Vec<_>>()
     });
     let mut q = ScalarCsr::with_pattern(n, pairs);
-    for BendingPatch { vertices: vs, weights: ws, area } in patches {
+    for BendingPatch { vertices: vs, weights: ws, area, .. } in patches {
         for (a, wa) in vs.iter().zip(ws) {
             for (b, wb) in vs.iter().zip(ws) {
                 let mut e = 0.0;
@@ -645,18 +735,6 @@ fn bending_matrix(n: usize, patches: &[BendingPatch], stiffness: &BendingStiffne
         }
     }
     q
-}
-
-fn norm3(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-}
-
-/// Barycentric coordinates of `p` with respect to the triangle (a, b, c).
-fn barycentric(p: DVec2, a: DVec2, b: DVec2, c: DVec2) -> [f64; 3] {
-    let area = (b - a).perp_dot(c - a);
-    let la = (b - p).perp_dot(c - p) / area;
-    let lb = (c - p).perp_dot(a - p) / area;
-    [la, lb, 1.0 - la - lb]
 }
 
 #[cfg(test)]

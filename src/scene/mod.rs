@@ -1,0 +1,102 @@
+//! Scenes: a preset turned into a model, an initial state, a test rig and its measurements.
+//! One registry (`preset::SCENES`) feeds the command line, the tests and the viewer.
+
+pub mod preset;
+pub mod rigs;
+pub mod run;
+pub mod strip;
+
+pub use preset::{SceneConfig, SceneKind, load_scene};
+pub use run::{Metrics, RunOptions, run_scene};
+
+use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};
+use glam::{DVec2, DVec3};
+use rand::{Rng, SeedableRng};
+use rigs::Rig;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum SceneError {
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error("{0}")]
+    Setup(String),
+}
+
+/// A scene ready to step: model, state, integrator and its rig's measurements.
+pub struct Scene {
+    pub config: SceneConfig,
+    pub model: Model,
+    pub state: State,
+    pub integrator: Integrator,
+    pub rig: Rig,
+    /// Steps between measurement samples.
+    sample_every: u64,
+}
+
+/// Standard gravity, m/s².
+pub const GRAVITY: f64 = 9.81;
+
+impl Scene {
+    pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
+        let fabric = config.fabric.to_fabric().map_err(ModelError::from)?;
+        let options = PhysicsOptions {
+            membrane: config.physics.membrane,
+            bending: config.physics.bending,
+            gravity: if config.physics.gravity { DVec3::new(0.0, 0.0, -GRAVITY) } else { DVec3::ZERO },
+            damping: config.solver.damping,
+        };
+        let c = &config.cloth;
+        let h = config.mesh.edge_length;
+        let warp = c.warp_angle_deg.to_radians();
+        // Strips clamped at one end carry a clamp band behind x = 0, a whole number of cells long.
+        let clamp_band = match config.scene.kind {
+            SceneKind::Cantilever | SceneKind::Arc => {
+                let cells = (config.test.clamp_length.unwrap_or(2.0 * h) / h).round().max(2.0);
+                cells * (c.length / (c.length / h).round().max(1.0))
+            }
+            _ => 0.0,
+        };
+        let mut mesh = Mesh::rectangle(c.length + clamp_band, c.width, h, config.mesh.pattern, config.scene.seed)
+            .map_err(ModelError::from)?;
+        for p in &mut mesh.rest {
+            p.x -= clamp_band;
+        }
+        let mut model = Model::new(&mesh, &fabric, warp, options)?;
+        let mut x: Vec<DVec3> = mesh.rest.iter().map(|p| DVec3::new(p.x, p.y, 0.0)).collect();
+        let rig = Rig::attach(&config, &mut model, &x, clamp_band)?;
+        if let Some(amplitude) = config.test.perturbation {
+            // The paper's start: a random displacement along the normal, between 0 and the amplitude.
+            let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(config.scene.seed);
+            for (i, p) in x.iter_mut().enumerate() {
+                if !model.fixed[i] {
+                    p.z += rng.random_range(0.0..=amplitude);
+                }
+            }
+        }
+        let mut integrator = Integrator::new(config.solver.integrator, config.solver.dt);
+        integrator.newton = config.solver.newton;
+        let steps = (config.scene.duration / config.solver.dt).ceil().max(1.0) as u64;
+        let sample_every = (steps / 400).max(1);
+        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, sample_every })
+    }
+
+    /// Advances one step and samples the rig's measurements on schedule.
+    pub fn step(&mut self) -> Result<StepReport, StepError> {
+        let report = self.integrator.step(&self.model, &mut self.state)?;
+        if self.state.steps % self.sample_every == 0 {
+            self.rig.sample(&self.model, &self.state);
+        }
+        Ok(report)
+    }
+
+    /// The rig's measurements as JSON.
+    pub fn measures(&self) -> serde_json::Value {
+        self.rig.finish(&self.model, &self.state)
+    }
+
+    /// Rest positions as 2D points (for placing things by rest coordinates).
+    pub fn rest(&self) -> &[DVec2] {
+        &self.model.rest
+    }
+}

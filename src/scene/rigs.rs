@@ -1,0 +1,334 @@
+//! Test rigs: how each laboratory test holds and drives the cloth, and what it measures.
+
+use super::strip::{Columns, count_half_waves, fit_circle_radius, group_force, inner_neighbours, tributary_widths, vertices_where};
+use super::{SceneConfig, SceneError, SceneKind};
+use crate::sim::{EndMoment, Model, Motion, State};
+use glam::{DVec2, DVec3};
+use serde_json::json;
+
+/// Rest coordinates are compared with this tolerance when picking edge vertices, m.
+const ON_EDGE: f64 = 1e-9;
+
+pub enum Rig {
+    Tensile(Tensile),
+    Cantilever(Cantilever),
+    Arc(Arc),
+    Euler(Euler),
+    Shear(Shear),
+}
+
+pub struct Tensile {
+    moving: Vec<u32>,
+    width: f64,
+    length: f64,
+    /// Extensometer gauge marks: columns at a quarter and three quarters of the length.
+    gauge: (Vec<u32>, Vec<u32>),
+    gauge_rest_length: f64,
+    /// The two edge vertices of the middle cross-section, for the lateral contraction.
+    mid_edges: (u32, u32),
+    /// (clamp strain, extensometer strain, lateral strain, stress N/m).
+    samples: Vec<[f64; 4]>,
+}
+
+pub struct Cantilever {
+    columns: Columns,
+    length: f64,
+}
+
+pub struct Arc {
+    columns: Columns,
+    length: f64,
+    moment: f64,
+}
+
+pub struct Euler {
+    left: Vec<u32>,
+    right: Vec<u32>,
+    columns: Columns,
+    width: f64,
+    length: f64,
+    /// (t, end shortening fraction, end force N/m, amplitude m, lobes).
+    history: Vec<(f64, f64, f64, f64, usize)>,
+    speed: f64,
+}
+
+pub struct Shear {
+    moving: Vec<u32>,
+    width: f64,
+    length: f64,
+}
+
+impl Rig {
+    /// Pins and drives the rig's vertices on `model` and prepares its measurements.
+    pub fn attach(config: &SceneConfig, model: &mut Model, x: &[DVec3], clamp_band: f64) -> Result<Self, SceneError> {
+        let (length, width, h) = (config.cloth.length, config.cloth.width, config.mesh.edge_length);
+        let rest = model.rest.clone();
+        let t = &config.test;
+        let pin_all = |model: &mut Model, group: &[u32]| {
+            for &v in group {
+                model.pin(v, x[v as usize]);
+            }
+        };
+        Ok(match config.scene.kind {
+            SceneKind::Tensile => {
+                let fixed = vertices_where(&rest, |p| p.x < ON_EDGE);
+                let moving = vertices_where(&rest, |p| p.x > length - ON_EDGE);
+                let speed = t.speed.expect("checked when loading");
+                let stop = t.max_strain.expect("checked when loading") * length / speed;
+                pin_all(model, &fixed);
+                model.drive(&moving, x, Motion { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop });
+                let columns = Columns::new(&rest, length, h);
+                let (lo, hi) = (columns.nearest(0.25 * length), columns.nearest(0.75 * length));
+                let gauge_rest_length = columns.rest_x[hi] - columns.rest_x[lo];
+                let mid = &columns.vertices[columns.nearest(0.5 * length)];
+                let bottom = *mid.iter().min_by(|a, b| rest[**a as usize].y.total_cmp(&rest[**b as usize].y)).unwrap();
+                let top = *mid.iter().max_by(|a, b| rest[**a as usize].y.total_cmp(&rest[**b as usize].y)).unwrap();
+                Rig::Tensile(Tensile {
+                    moving,
+                    width,
+                    length,
+                    gauge: (columns.vertices[lo].clone(), columns.vertices[hi].clone()),
+                    gauge_rest_length,
+                    mid_edges: (bottom, top),
+                    samples: Vec::new(),
+                })
+            }
+            SceneKind::Cantilever | SceneKind::Arc => {
+                let clamp = vertices_where(&rest, |p| p.x < ON_EDGE);
+                pin_all(model, &clamp);
+                let free: Vec<DVec2> = rest.iter().map(|p| DVec2::new(p.x + clamp_band, p.y)).collect();
+                let mut columns = Columns::new(&free, length + clamp_band, h);
+                for x in &mut columns.rest_x {
+                    *x -= clamp_band;
+                }
+                if config.scene.kind == SceneKind::Cantilever {
+                    Rig::Cantilever(Cantilever { columns, length })
+                } else {
+                    let moment = t.moment.expect("checked when loading");
+                    let mut end = vertices_where(&rest, |p| p.x > length - ON_EDGE);
+                    end.sort_by(|a, b| rest[*a as usize].y.total_cmp(&rest[*b as usize].y));
+                    let widths = tributary_widths(&end.iter().map(|&v| rest[v as usize].y).collect::<Vec<_>>());
+                    let inner = inner_neighbours(model, &end);
+                    let pairs = end.iter().zip(&inner).zip(&widths).map(|((&o, &i), &w)| (i, o, moment * w)).collect();
+                    model.end_moments.push(EndMoment { pairs, e1: DVec3::X, e2: DVec3::Z });
+                    Rig::Arc(Arc { columns, length, moment })
+                }
+            }
+            SceneKind::EulerBuckling => {
+                let left = vertices_where(&rest, |p| p.x < ON_EDGE);
+                let right = vertices_where(&rest, |p| p.x > length - ON_EDGE);
+                let speed = t.speed.expect("checked when loading");
+                let stop = t.end_shortening.expect("checked when loading") * length / speed;
+                // Both ends move, each at half the approach speed, so the midspan stays put.
+                model.drive(&left, x, Motion { velocity: DVec3::new(0.5 * speed, 0.0, 0.0), start: 0.0, stop });
+                model.drive(&right, x, Motion { velocity: DVec3::new(-0.5 * speed, 0.0, 0.0), start: 0.0, stop });
+                let columns = Columns::new(&rest, length, h);
+                Rig::Euler(Euler { left, right, columns, width, length, history: Vec::new(), speed })
+            }
+            SceneKind::ShearBuckling => {
+                let clamped = vertices_where(&rest, |p| p.y < ON_EDGE);
+                let moving = vertices_where(&rest, |p| p.y > width - ON_EDGE);
+                let speed = t.speed.expect("checked when loading");
+                let travel = width * t.shear_angle_deg.expect("checked when loading").to_radians().tan();
+                pin_all(model, &clamped);
+                model.drive(&moving, x, Motion { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop: travel / speed });
+                Rig::Shear(Shear { moving, width, length })
+            }
+        })
+    }
+
+    /// Records one sample of the rig's time series.
+    pub fn sample(&mut self, model: &Model, state: &State) {
+        match self {
+            Rig::Tensile(r) => {
+                let mut f = vec![DVec3::ZERO; state.x.len()];
+                model.forces(&state.x, &mut f);
+                // The cloth pulls the moving clamp back (−x); the clamp carries the opposite.
+                let stress = -group_force(&f, &r.moving).x / r.width;
+                let clamp_strain = (model.prescribed_position(r.moving[0] as usize, state.time).x - r.length) / r.length;
+                let mean_x = |g: &[u32]| g.iter().map(|&v| state.x[v as usize].x).sum::<f64>() / g.len() as f64;
+                let extensometer = (mean_x(&r.gauge.1) - mean_x(&r.gauge.0)) / r.gauge_rest_length - 1.0;
+                let (b, t) = r.mid_edges;
+                let lateral = (state.x[t as usize].y - state.x[b as usize].y) / r.width - 1.0;
+                r.samples.push([clamp_strain, extensometer, lateral, stress]);
+            }
+            Rig::Euler(r) => {
+                let mut f = vec![DVec3::ZERO; state.x.len()];
+                model.forces(&state.x, &mut f);
+                // Compressed cloth pushes the left end towards −x and the right end towards +x.
+                let force = 0.5 * (-group_force(&f, &r.left).x + group_force(&f, &r.right).x) / r.width;
+                let span = model.prescribed_position(r.right[0] as usize, state.time).x
+                    - model.prescribed_position(r.left[0] as usize, state.time).x;
+                let shortening = 1.0 - span / r.length;
+                let line = r.columns.centre_line(&state.x);
+                let z: Vec<f64> = line.iter().map(|p| p.z).collect();
+                let amplitude = z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                r.history.push((state.time, shortening, force, amplitude, count_half_waves(&z, 0.2)));
+            }
+            _ => {}
+        }
+    }
+
+    /// The rig's measurements at the end of the run.
+    pub fn finish(&self, model: &Model, state: &State) -> serde_json::Value {
+        match self {
+            Rig::Tensile(r) => {
+                // A few dozen evenly spaced points of the pull.
+                let stride = (r.samples.len() / 40).max(1);
+                let picked: Vec<&[f64; 4]> = r.samples.iter().step_by(stride).collect();
+                let last = r.samples.last().copied().unwrap_or([0.0; 4]);
+                let poisson = if last[1].abs() > 0.0 { -last[2] / last[1] } else { 0.0 };
+                json!({
+                    "stress_strain": picked.iter().map(|s| [s[1], s[3]]).collect::<Vec<_>>(),
+                    "clamp_stress_strain": picked.iter().map(|s| [s[0], s[3]]).collect::<Vec<_>>(),
+                    "lateral_strain": picked.iter().map(|s| [s[1], s[2]]).collect::<Vec<_>>(),
+                    "poisson_ratio": poisson,
+                    "final_stress": last[3],
+                    "final_strain": last[1],
+                    "strain_definition": "extensometer over the central half of the gauge length; stress = moving-clamp force / initial width",
+                })
+            }
+            Rig::Cantilever(r) => {
+                let line = r.columns.centre_line(&state.x);
+                let n = line.len();
+                let (tip, before) = (line[n - 1], line[n - 2]);
+                let drop = -tip.z;
+                let tangent = tip - before;
+                let weight = model.mass.iter().sum::<f64>() / model.vertex_area.iter().sum::<f64>() * super::GRAVITY;
+                let b = model.bending_stiffness.rigidity_at(-model.warp_angle);
+                json!({
+                    "tip_drop": drop,
+                    "tip_reach": tip.x,
+                    "tip_angle_deg": (-tangent.z).atan2(tangent.x).to_degrees(),
+                    "chord_angle_deg": drop.atan2(tip.x).to_degrees(),
+                    "lambda": weight * r.length.powi(3) / b,
+                    "bending_length": (b / weight).cbrt(),
+                })
+            }
+            Rig::Arc(r) => {
+                let line = r.columns.centre_line(&state.x);
+                let points: Vec<(f64, f64)> = r
+                    .columns
+                    .rest_x
+                    .iter()
+                    .zip(&line)
+                    .filter(|(x, _)| **x >= 0.25 * r.length && **x <= 0.75 * r.length)
+                    .map(|(_, p)| (p.x, p.z))
+                    .collect();
+                let curvature = fit_circle_radius(&points).map_or(0.0, |radius| 1.0 / radius);
+                json!({
+                    "curvature": curvature,
+                    "moment": r.moment,
+                    "rigidity": if curvature > 0.0 { r.moment / curvature } else { f64::INFINITY },
+                })
+            }
+            Rig::Euler(r) => {
+                let b = model.bending_stiffness.rigidity_at(-model.warp_angle);
+                let critical = r.history.iter().find(|h| h.3 > 0.05 * r.length).map(|h| h.2);
+                let line = r.columns.centre_line(&state.x);
+                let mid = r.columns.nearest(0.5 * r.length);
+                let last = r.history.last().copied().unwrap_or_default();
+                // Lobe history as (t, lobes) at each change.
+                let mut lobe_history: Vec<(f64, usize)> = Vec::new();
+                for h in &r.history {
+                    if h.3 > 1e-3 * r.length && lobe_history.last().is_none_or(|l| l.1 != h.4) {
+                        lobe_history.push((h.0, h.4));
+                    }
+                }
+                json!({
+                    "critical_load": critical,
+                    "critical_load_definition": "end force when the largest normal deflection first exceeds 5 % of the length",
+                    "euler_load": std::f64::consts::PI.powi(2) * b / r.length.powi(2),
+                    "end_force": last.2,
+                    "end_shortening": last.1,
+                    "midspan_deflection": line[mid].z.abs(),
+                    "lobes": last.4,
+                    "lobe_history": lobe_history.iter().map(|l| json!([l.0, l.1])).collect::<Vec<_>>(),
+                    "compression_speed": r.speed,
+                    "force_history": r.history.iter().step_by((r.history.len() / 100).max(1)).map(|h| json!([h.0, h.1, h.2, h.3])).collect::<Vec<_>>(),
+                })
+            }
+            Rig::Shear(r) => shear_measures(r, model, state),
+        }
+    }
+}
+
+/// Wrinkle direction, count and wavelength from the normal deflection field.
+fn shear_measures(r: &Shear, model: &Model, state: &State) -> serde_json::Value {
+    let travel = state.x[r.moving[0] as usize].x - model.rest[r.moving[0] as usize].x;
+    let shear_angle = travel.atan2(r.width);
+    // Structure tensor of the deflection gradient over the central region, in the deformed
+    // plane: wrinkle crests run across the dominant gradient direction.
+    let inside = |p: DVec2| p.y > 0.15 * r.width && p.y < 0.85 * r.width && p.x > 0.15 * r.length && p.x < 0.85 * r.length;
+    let mut j = [0.0f64; 3];
+    let mut amplitude = 0.0f64;
+    for tri in &model.triangles {
+        let rest_c = tri.iter().map(|&v| model.rest[v as usize]).sum::<DVec2>() / 3.0;
+        if !inside(rest_c) {
+            continue;
+        }
+        let p = tri.map(|v| state.x[v as usize]);
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let det = e1.x * e2.y - e2.x * e1.y;
+        if det.abs() < 1e-14 {
+            continue;
+        }
+        // Gradient of the linear interpolant of z over the triangle's xy projection.
+        let (dz1, dz2) = (e1.z, e2.z);
+        let gx = (dz1 * e2.y - dz2 * e1.y) / det;
+        let gy = (dz2 * e1.x - dz1 * e2.x) / det;
+        let area = 0.5 * det.abs();
+        j[0] += area * gx * gx;
+        j[1] += area * gy * gy;
+        j[2] += area * gx * gy;
+        for q in &p {
+            amplitude = amplitude.max(q.z.abs());
+        }
+    }
+    // Principal direction of the larger eigenvalue of [[j0, j2], [j2, j1]].
+    let gradient_angle = 0.5 * (2.0 * j[2]).atan2(j[0] - j[1]);
+    let crest_angle = (gradient_angle + std::f64::consts::FRAC_PI_2).rem_euclid(std::f64::consts::PI);
+    // Sample z along the line through the centre across the crests.
+    let centre = state.x.iter().sum::<DVec3>() / state.x.len() as f64;
+    let across = DVec2::from_angle(gradient_angle);
+    let half = 0.5 * r.length.min(r.width / crest_angle.sin().abs().max(0.2));
+    let samples = 240;
+    let mut profile = Vec::with_capacity(samples);
+    for k in 0..samples {
+        let s = -half + 2.0 * half * k as f64 / (samples - 1) as f64;
+        let q = DVec2::new(centre.x, centre.y) + s * across;
+        if let Some(z) = interpolate_z(model, state, q) {
+            profile.push((s, z - centre.z));
+        }
+    }
+    let zs: Vec<f64> = profile.iter().map(|p| p.1).collect();
+    let half_waves = count_half_waves(&zs, 0.2);
+    let span = profile.last().map_or(0.0, |p| p.0) - profile.first().map_or(0.0, |p| p.0);
+    let wavelength = if half_waves >= 2 { 2.0 * span / half_waves as f64 } else { 0.0 };
+    json!({
+        "shear_angle_deg": shear_angle.to_degrees(),
+        "wrinkle_angle_deg": crest_angle.to_degrees(),
+        "wrinkle_count": half_waves.div_ceil(2),
+        "wrinkle_wavelength": wavelength,
+        "wrinkle_amplitude": amplitude,
+    })
+}
+
+/// z of the deformed surface above the point `q` of the xy plane (first triangle found).
+fn interpolate_z(model: &Model, state: &State, q: DVec2) -> Option<f64> {
+    for tri in &model.triangles {
+        let p = tri.map(|v| state.x[v as usize]);
+        let (a, b, c) = (p[0].truncate(), p[1].truncate(), p[2].truncate());
+        let area = (b - a).perp_dot(c - a);
+        if area.abs() < 1e-14 {
+            continue;
+        }
+        let la = (b - q).perp_dot(c - q) / area;
+        let lb = (c - q).perp_dot(a - q) / area;
+        let lc = 1.0 - la - lb;
+        if la >= -1e-9 && lb >= -1e-9 && lc >= -1e-9 {
+            return Some(la * p[0].z + lb * p[1].z + lc * p[2].z);
+        }
+    }
+    None
+}
