@@ -49,15 +49,21 @@ impl Scene {
         let c = &config.cloth;
         let h = config.mesh.edge_length;
         let warp = c.warp_angle_deg.to_radians();
-        // Strips clamped at one end carry a clamp band behind x = 0, a whole number of cells long.
-        let clamp_band = match config.scene.kind {
-            SceneKind::Cantilever | SceneKind::Arc => {
-                let cells = (config.test.clamp_length.unwrap_or(2.0 * h) / h).round().max(2.0);
-                cells * (c.length / (c.length / h).round().max(1.0))
-            }
-            _ => 0.0,
+        // Strips clamped at one end carry a clamp band behind x = 0, a whole number of cells
+        // long, and the mesh is made at the exact column spacing so that a column of vertices
+        // lies on the clamp line.
+        let clamped = matches!(config.scene.kind, SceneKind::Cantilever | SceneKind::Arc);
+        let (clamp_band, spacing) = if clamped {
+            let cells = (c.length / h).round().max(1.0);
+            let spacing = c.length / cells;
+            let clamp_cells = (config.test.clamp_length.unwrap_or(2.0 * h) / spacing).round().max(2.0);
+            (clamp_cells * spacing, spacing)
+        } else {
+            (0.0, h)
         };
-        let mut mesh = Mesh::rectangle(c.length + clamp_band, c.width, h, config.mesh.pattern, config.scene.seed)
+        // The arc also has a grip band beyond the free length.
+        let grip_band = if config.scene.kind == SceneKind::Arc { clamp_band } else { 0.0 };
+        let mut mesh = Mesh::rectangle(c.length + clamp_band + grip_band, c.width, spacing, config.mesh.pattern, config.scene.seed)
             .map_err(ModelError::from)?;
         for p in &mut mesh.rest {
             p.x -= clamp_band;

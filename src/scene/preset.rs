@@ -212,12 +212,27 @@ pub struct TestSection {
     pub shear_angle_deg: Option<f64>,
     /// Clamp speed, m/s (Euler buckling: the speed at which the ends approach each other).
     pub speed: Option<f64>,
-    /// Arc: end moment per unit width, N·m/m.
-    pub moment: Option<f64>,
+    /// Arc: curvature the grips roll the strip to, 1/m.
+    pub curvature: Option<f64>,
     /// Largest random normal displacement added at the start, m.
     pub perturbation: Option<f64>,
-    /// Cantilever and arc: length of the clamped band behind the overhang, m.
+    /// Cantilever and arc: length of the clamped band (and the arc's grip), m.
     pub clamp_length: Option<f64>,
+    /// Shear buckling: how the moving grip travels (default `trellis`).
+    pub shear_kinematics: Option<ShearKinematics>,
+}
+
+/// How the shear rig's moving grip travels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShearKinematics {
+    /// Swings on the cross yarns, which keep their length (picture-frame shear): pure shear
+    /// of the sheet, principal tension at 45° − γ/2 to the clamped edge.
+    #[default]
+    Trellis,
+    /// Slides along the warp with the gap held: the cross yarns stretch by 1/cos γ − 1,
+    /// which with stiff yarns removes the compression (and the wrinkles) past γ ≈ 2G/E.
+    Simple,
 }
 
 /// Where a preset came from: a bundled name or a file.
@@ -377,7 +392,7 @@ fn check_scene(c: &SceneConfig) -> Result<(), String> {
             need("test.speed", c.test.speed)?;
         }
         SceneKind::Arc => {
-            need("test.moment", c.test.moment)?;
+            need("test.curvature", c.test.curvature)?;
         }
         SceneKind::Cantilever => {}
     }

@@ -1,8 +1,9 @@
 //! Test rigs: how each laboratory test holds and drives the cloth, and what it measures.
 
-use super::strip::{Columns, count_half_waves, fit_circle_radius, group_force, inner_neighbours, tributary_widths, vertices_where};
+use super::strip::{Columns, count_half_waves, fit_circle_radius, group_force, vertices_where};
+use super::preset::ShearKinematics;
 use super::{SceneConfig, SceneError, SceneKind};
-use crate::sim::{EndMoment, Model, Motion, State};
+use crate::sim::{Model, Motion, State};
 use glam::{DVec2, DVec3};
 use serde_json::json;
 
@@ -38,7 +39,8 @@ pub struct Cantilever {
 pub struct Arc {
     columns: Columns,
     length: f64,
-    moment: f64,
+    width: f64,
+    grip: Vec<u32>,
 }
 
 pub struct Euler {
@@ -76,7 +78,7 @@ impl Rig {
                 let speed = t.speed.expect("checked when loading");
                 let stop = t.max_strain.expect("checked when loading") * length / speed;
                 pin_all(model, &fixed);
-                model.drive(&moving, x, Motion { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop });
+                model.drive(&moving, x, Motion::Linear { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop });
                 let columns = Columns::new(&rest, length, h);
                 let (lo, hi) = (columns.nearest(0.25 * length), columns.nearest(0.75 * length));
                 let gauge_rest_length = columns.rest_x[hi] - columns.rest_x[lo];
@@ -96,23 +98,26 @@ impl Rig {
             SceneKind::Cantilever | SceneKind::Arc => {
                 let clamp = vertices_where(&rest, |p| p.x < ON_EDGE);
                 pin_all(model, &clamp);
+                let mut rigid = vec![false; rest.len()];
+                clamp.iter().for_each(|&v| rigid[v as usize] = true);
                 let free: Vec<DVec2> = rest.iter().map(|p| DVec2::new(p.x + clamp_band, p.y)).collect();
-                let mut columns = Columns::new(&free, length + clamp_band, h);
+                let mut columns = Columns::new(&free, length + 2.0 * clamp_band, h);
                 for x in &mut columns.rest_x {
                     *x -= clamp_band;
                 }
-                if config.scene.kind == SceneKind::Cantilever {
+                let rig = if config.scene.kind == SceneKind::Cantilever {
                     Rig::Cantilever(Cantilever { columns, length })
                 } else {
-                    let moment = t.moment.expect("checked when loading");
-                    let mut end = vertices_where(&rest, |p| p.x > length - ON_EDGE);
-                    end.sort_by(|a, b| rest[*a as usize].y.total_cmp(&rest[*b as usize].y));
-                    let widths = tributary_widths(&end.iter().map(|&v| rest[v as usize].y).collect::<Vec<_>>());
-                    let inner = inner_neighbours(model, &end);
-                    let pairs = end.iter().zip(&inner).zip(&widths).map(|((&o, &i), &w)| (i, o, moment * w)).collect();
-                    model.end_moments.push(EndMoment { pairs, e1: DVec3::X, e2: DVec3::Z });
-                    Rig::Arc(Arc { columns, length, moment })
-                }
+                    // Pure bending: the far grip rolls the strip into an arc of the target
+                    // curvature over the first half of the run, then holds while it settles.
+                    let grip = vertices_where(&rest, |p| p.x > length - ON_EDGE);
+                    grip.iter().for_each(|&v| rigid[v as usize] = true);
+                    let curvature = t.curvature.expect("checked when loading");
+                    model.drive(&grip, x, Motion::Roll { length, curvature, ramp: 0.5 * config.scene.duration });
+                    Rig::Arc(Arc { columns, length, width, grip })
+                };
+                model.set_clamped_region(&rigid)?;
+                rig
             }
             SceneKind::EulerBuckling => {
                 let left = vertices_where(&rest, |p| p.x < ON_EDGE);
@@ -120,8 +125,8 @@ impl Rig {
                 let speed = t.speed.expect("checked when loading");
                 let stop = t.end_shortening.expect("checked when loading") * length / speed;
                 // Both ends move, each at half the approach speed, so the midspan stays put.
-                model.drive(&left, x, Motion { velocity: DVec3::new(0.5 * speed, 0.0, 0.0), start: 0.0, stop });
-                model.drive(&right, x, Motion { velocity: DVec3::new(-0.5 * speed, 0.0, 0.0), start: 0.0, stop });
+                model.drive(&left, x, Motion::Linear { velocity: DVec3::new(0.5 * speed, 0.0, 0.0), start: 0.0, stop });
+                model.drive(&right, x, Motion::Linear { velocity: DVec3::new(-0.5 * speed, 0.0, 0.0), start: 0.0, stop });
                 let columns = Columns::new(&rest, length, h);
                 Rig::Euler(Euler { left, right, columns, width, length, history: Vec::new(), speed })
             }
@@ -129,9 +134,17 @@ impl Rig {
                 let clamped = vertices_where(&rest, |p| p.y < ON_EDGE);
                 let moving = vertices_where(&rest, |p| p.y > width - ON_EDGE);
                 let speed = t.speed.expect("checked when loading");
-                let travel = width * t.shear_angle_deg.expect("checked when loading").to_radians().tan();
+                let angle = t.shear_angle_deg.expect("checked when loading").to_radians();
                 pin_all(model, &clamped);
-                model.drive(&moving, x, Motion { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop: travel / speed });
+                let motion = match t.shear_kinematics.unwrap_or_default() {
+                    // The moving grip slides along the warp; the gap stays, so the cross yarns stretch.
+                    ShearKinematics::Simple => {
+                        Motion::Linear { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop: width * angle.tan() / speed }
+                    }
+                    // The moving grip swings on the cross yarns, which keep their length.
+                    ShearKinematics::Trellis => Motion::Swing { radius: width, angular_speed: speed / width, stop: angle * width / speed },
+                };
+                model.drive(&moving, x, motion);
                 Rig::Shear(Shear { moving, width, length })
             }
         })
@@ -216,10 +229,18 @@ impl Rig {
                     .map(|(_, p)| (p.x, p.z))
                     .collect();
                 let curvature = fit_circle_radius(&points).map_or(0.0, |radius| 1.0 / radius);
+                // Moment the cloth exerts on the grip about the grip line (its rest x = length),
+                // per unit width: what the grip's torque motor would read.
+                let mut f = vec![DVec3::ZERO; state.x.len()];
+                model.forces(&state.x, &mut f);
+                let pivot_vertex = *r.grip.iter().min_by(|a, b| model.rest[**a as usize].x.total_cmp(&model.rest[**b as usize].x)).unwrap();
+                let pivot = state.x[pivot_vertex as usize];
+                let torque: f64 = r.grip.iter().map(|&v| (state.x[v as usize] - pivot).cross(f[v as usize]).y).sum();
+                let moment = torque / r.width;
                 json!({
                     "curvature": curvature,
-                    "moment": r.moment,
-                    "rigidity": if curvature > 0.0 { r.moment / curvature } else { f64::INFINITY },
+                    "moment": moment,
+                    "rigidity": if curvature > 0.0 { moment / curvature } else { f64::INFINITY },
                 })
             }
             Rig::Euler(r) => {
@@ -255,8 +276,9 @@ impl Rig {
 
 /// Wrinkle direction, count and wavelength from the normal deflection field.
 fn shear_measures(r: &Shear, model: &Model, state: &State) -> serde_json::Value {
-    let travel = state.x[r.moving[0] as usize].x - model.rest[r.moving[0] as usize].x;
-    let shear_angle = travel.atan2(r.width);
+    // Angle between the deformed cross direction (clamp to grip) and its rest direction.
+    let grip = state.x[r.moving[0] as usize] - DVec3::new(model.rest[r.moving[0] as usize].x, 0.0, 0.0);
+    let shear_angle = grip.x.atan2(grip.y);
     // Structure tensor of the deflection gradient over the central region, in the deformed
     // plane: wrinkle crests run across the dominant gradient direction.
     let inside = |p: DVec2| p.y > 0.15 * r.width && p.y < 0.85 * r.width && p.x > 0.15 * r.length && p.x < 0.85 * r.length;

@@ -103,7 +103,7 @@ pub struct NewtonSettings {
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { max_iterations: 30, tolerance: 1e-7, cg_tolerance: 1e-5, cg_max_iterations: 3000 }
+        Self { max_iterations: 30, tolerance: 1e-5, cg_tolerance: 1e-4, cg_max_iterations: 3000 }
     }
 }
 

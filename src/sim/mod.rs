@@ -11,4 +11,4 @@ pub use curve::PiecewiseLinear;
 pub use integrate::{Integrator, IntegratorKind, NewtonSettings, State, StepError, StepReport};
 pub use material::{BendingStiffness, Fabric, FabricError, MembraneLaw};
 pub use mesh::{Mesh, MeshError, Pattern};
-pub use model::{EndMoment, Model, ModelError, Motion, PhysicsOptions};
+pub use model::{Model, ModelError, Motion, PhysicsOptions};

@@ -46,33 +46,73 @@ pub enum ModelError {
     BadDamping(f64),
 }
 
-/// Prescribed motion of a group of vertices: displacement `velocity · clamp(t − start, 0, stop − start)`.
+/// Prescribed motion of a group of vertices.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Motion {
-    /// Velocity while moving, m/s.
-    pub velocity: DVec3,
-    /// Time the motion starts, s.
-    pub start: f64,
-    /// Time the motion stops (the group then holds still), s.
-    pub stop: f64,
+pub enum Motion {
+    /// Straight line: displacement `velocity · clamp(t − start, 0, stop − start)`.
+    Linear {
+        /// Velocity while moving, m/s.
+        velocity: DVec3,
+        /// Time the motion starts, s.
+        start: f64,
+        /// Time the motion stops (the group then holds still), s.
+        stop: f64,
+    },
+    /// Swing along a circle of `radius` in the xy plane, as the free end of a rigid link
+    /// hinged below the group: displacement (R sin a, R cos a − R, 0) with
+    /// a = `angular_speed` · min(t, stop). A trellis (picture-frame) shear.
+    Swing {
+        /// Link length, m.
+        radius: f64,
+        /// Rad/s.
+        angular_speed: f64,
+        /// Time the swing stops, s.
+        stop: f64,
+    },
+    /// Rigid grip at the end of a strip rolled into an arc (pure bending, KES-B style): the
+    /// strip's free length `length` from x = 0 along +x is wrapped onto a circle of
+    /// curvature κ(t) = `curvature` · min(t / `ramp`, 1) curling towards +z, and the grip,
+    /// whose rest x is ≥ `length`, continues rigidly along the end tangent.
+    Roll {
+        /// Free length between the clamp line and the grip line, m.
+        length: f64,
+        /// Final curvature, 1/m.
+        curvature: f64,
+        /// Time to reach it, s.
+        ramp: f64,
+    },
 }
 
 impl Motion {
-    pub const STILL: Motion = Motion { velocity: DVec3::ZERO, start: 0.0, stop: 0.0 };
+    /// Position at time `t` of a vertex of the group whose rest position is `anchor`.
+    pub fn position(&self, anchor: DVec3, t: f64) -> DVec3 {
+        match *self {
+            Motion::Roll { length, curvature, ramp } => {
+                let kappa = curvature * (t / ramp).clamp(0.0, 1.0);
+                let phi = kappa * length;
+                let end = if kappa.abs() < 1e-12 {
+                    DVec3::new(length, anchor.y, 0.0)
+                } else {
+                    DVec3::new(phi.sin() / kappa, anchor.y, (1.0 - phi.cos()) / kappa)
+                };
+                end + (anchor.x - length) * DVec3::new(phi.cos(), 0.0, phi.sin()) + DVec3::new(0.0, 0.0, anchor.z)
+            }
+            _ => anchor + self.displacement(t),
+        }
+    }
+
+    pub const STILL: Motion = Motion::Linear { velocity: DVec3::ZERO, start: 0.0, stop: 0.0 };
 
     pub fn displacement(&self, t: f64) -> DVec3 {
-        self.velocity * (t - self.start).clamp(0.0, (self.stop - self.start).max(0.0))
+        match *self {
+            Motion::Linear { velocity, start, stop } => velocity * (t - start).clamp(0.0, (stop - start).max(0.0)),
+            Motion::Swing { radius, angular_speed, stop } => {
+                let a = angular_speed * t.clamp(0.0, stop);
+                DVec3::new(radius * a.sin(), radius * (a.cos() - 1.0), 0.0)
+            }
+            Motion::Roll { .. } => unreachable!("a roll moves each vertex differently; use position()"),
+        }
     }
-}
-
-/// A conservative end moment: pairs of vertices (inner, outer) whose direction is turned by
-/// moments `m_j` (N·m each) in the plane spanned by `e1` (along the strip) and `e2`.
-/// Potential V = −Σ m_j φ_j with φ_j = atan2(t·e2, t·e1), t = x_outer − x_inner.
-#[derive(Debug, Clone)]
-pub struct EndMoment {
-    pub pairs: Vec<(u32, u32, f64)>,
-    pub e1: DVec3,
-    pub e2: DVec3,
 }
 
 /// Rest data of one triangle's strain rosette (paper Fig. 1).
@@ -117,7 +157,6 @@ pub struct Model {
     anchor: Vec<DVec3>,
     driver: Vec<u16>,
     motions: Vec<Motion>,
-    pub end_moments: Vec<EndMoment>,
     /// Undirected edges (a < b), for strain checks and drawing.
     pub edges: Vec<[u32; 2]>,
 }
@@ -163,7 +202,7 @@ impl Model {
         };
         let bending_stiffness = BendingStiffness::new(fabric)?;
         let (bending, bending_patches) = if options.bending {
-            let patches = bending_patches(mesh, warp_angle)?;
+            let patches = bending_patches(mesh, warp_angle, &vec![false; n])?;
             (Some(bending_matrix(n, &patches, &bending_stiffness)), patches)
         } else {
             (None, Vec::new())
@@ -186,7 +225,6 @@ impl Model {
             anchor: vec![DVec3::ZERO; n],
             driver: vec![0; n],
             motions: vec![Motion::STILL],
-            end_moments: Vec::new(),
             edges: edge_set,
         })
     }
@@ -217,12 +255,26 @@ impl Model {
         }
     }
 
-    /// Prescribed position of a fixed vertex at time `t`.
-    pub fn prescribed_position(&self, v: usize, t: f64) -> DVec3 {
-        self.anchor[v] + self.motions[self.driver[v] as usize].displacement(t)
+    /// Declares the vertices of a clamp: a region held rigidly (its vertices must also be
+    /// pinned or driven together). Bending stencils are rebuilt so that they do not fit
+    /// across the clamp line (see `bending_patches`).
+    pub fn set_clamped_region(&mut self, rigid: &[bool]) -> Result<(), ModelError> {
+        if self.bending.is_none() {
+            return Ok(());
+        }
+        let mesh = Mesh { rest: self.rest.clone(), triangles: self.triangles.clone() };
+        let patches = bending_patches(&mesh, self.warp_angle, rigid)?;
+        self.bending = Some(bending_matrix(self.rest.len(), &patches, &self.bending_stiffness));
+        self.bending_patches = patches;
+        Ok(())
     }
 
-    /// Total potential energy (elastic + gravity + applied moments), J.
+    /// Prescribed position of a fixed vertex at time `t`.
+    pub fn prescribed_position(&self, v: usize, t: f64) -> DVec3 {
+        self.motions[self.driver[v] as usize].position(self.anchor[v], t)
+    }
+
+    /// Total potential energy (elastic + gravity), J.
     pub fn potential_energy(&self, x: &[DVec3]) -> f64 {
         let mut energy = 0.0;
         if let Some(law) = &self.membrane_law {
@@ -236,12 +288,6 @@ impl Model {
         }
         if self.options.gravity != DVec3::ZERO {
             energy -= x.iter().zip(&self.mass).map(|(p, m)| m * self.options.gravity.dot(*p)).sum::<f64>();
-        }
-        for load in &self.end_moments {
-            for &(inner, outer, m) in &load.pairs {
-                let t = x[outer as usize] - x[inner as usize];
-                energy -= m * t.dot(load.e2).atan2(t.dot(load.e1));
-            }
         }
         energy
     }
@@ -273,17 +319,6 @@ impl Model {
             q.multiply_add(x, &mut qx);
             for (fi, q) in f.iter_mut().zip(qx) {
                 *fi -= q;
-            }
-        }
-        for load in &self.end_moments {
-            for &(inner, outer, m) in &load.pairs {
-                let t = x[outer as usize] - x[inner as usize];
-                let (u, w) = (t.dot(load.e1), t.dot(load.e2));
-                let r2 = u * u + w * w;
-                // dφ/dt for φ = atan2(w, u).
-                let grad = (-w * load.e1 + u * load.e2) / r2;
-                f[outer as usize] += m * grad;
-                f[inner as usize] -= m * grad;
             }
         }
     }
@@ -538,7 +573,7 @@ fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
 /// positions and its Hessian is a constant matrix Q (the anisotropic counterpart of Bergou et
 /// al.'s quadratic bending model). It is invariant to rigid motions, so the forces sum to
 /// zero and conserve momentum.
-fn bending_patches(mesh: &Mesh, warp_angle: f64) -> Result<Vec<BendingPatch>, ModelError> {
+fn bending_patches(mesh: &Mesh, warp_angle: f64, rigid: &[bool]) -> Result<Vec<BendingPatch>, ModelError> {
     let n = mesh.rest.len();
     let mut edge_owner: HashMap<[u32; 2], Vec<(usize, usize)>> = HashMap::new();
     let mut vertex_triangles: Vec<Vec<u32>> = vec![Vec::new(); n];
@@ -555,11 +590,20 @@ fn bending_patches(mesh: &Mesh, warp_angle: f64) -> Result<Vec<BendingPatch>, Mo
     }
     let warp: Vec<DVec2> = mesh.rest.iter().map(|&p| to_warp_frame(p, warp_angle)).collect();
     let scale = mesh.mean_edge_length();
+    // A clamped region moves rigidly: its curvature is zero while the cloth beside it bends,
+    // so a fit across the clamp line would smear that jump and make the root too soft.
+    // Edges inside the clamp (both ends rigid) fit rigid vertices only, which gives the
+    // clamp's exact slope; other edges fit free vertices plus the clamp line itself.
+    let on_clamp_line: Vec<bool> = (0..n)
+        .map(|v| rigid[v] && vertex_triangles[v].iter().any(|&t| mesh.triangles[t as usize].iter().any(|&u| !rigid[u as usize])))
+        .collect();
     // One gradient stencil per edge, shared by its triangles.
     let mut gradient_of_edge: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
     for (&edge, owners) in &edge_owner {
         let midpoint = 0.5 * (warp[edge[0] as usize] + warp[edge[1] as usize]);
-        let stencil = edge_gradient_stencil(mesh, &vertex_triangles, &warp, edge, midpoint, scale)
+        let inside_clamp = rigid[edge[0] as usize] && rigid[edge[1] as usize];
+        let usable = |v: u32| if inside_clamp { rigid[v as usize] } else { !rigid[v as usize] || on_clamp_line[v as usize] };
+        let stencil = edge_gradient_stencil(mesh, &vertex_triangles, &warp, edge, midpoint, scale, usable)
             .ok_or(ModelError::SingularBendingStencil { triangle: owners[0].0 })?;
         gradient_of_edge.insert(edge, stencil);
     }
@@ -600,6 +644,7 @@ fn edge_gradient_stencil(
     edge: [u32; 2],
     midpoint: DVec2,
     scale: f64,
+    usable: impl Fn(u32) -> bool,
 ) -> Option<Vec<(u32, DVec2)>> {
     let mut points: Vec<u32> = edge.to_vec();
     for _ring in 0..3 {
@@ -609,6 +654,7 @@ fn edge_gradient_stencil(
                 grown.extend_from_slice(&mesh.triangles[t as usize]);
             }
         }
+        grown.retain(|&v| usable(v));
         grown.sort_unstable();
         grown.dedup();
         points = grown;

