@@ -1,106 +1,280 @@
-//! scratch
+//! Validates the time integrators' conservation laws on a free, undamped, crumpled sheet:
+//! linear momentum (every integrator), angular momentum (symplectic Euler), bounded energy
+//! without drift below the explicit stability limit, and a clean divergence report above it.
+
 use glam::{DVec2, DVec3};
 use rosette::scene::load_scene;
-use rosette::sim::*;
+use rosette::sim::{Fabric, Integrator, IntegratorKind, Mesh, Model, Pattern, PhysicsOptions, PiecewiseLinear, State, StepError};
 
-fn wool(linear: bool) -> Fabric {
-    let (config, _) = load_scene("tensile-warp", &[]).unwrap();
-    let mut f = config.fabric.to_fabric().unwrap();
-    if linear {
-        f.tensile_warp = PiecewiseLinear::linear(1000.0);
-        f.tensile_weft = PiecewiseLinear::linear(800.0);
-    }
-    f
+/// The paper's wool (bundled preset): nonlinear warp and weft curves, G = 40 N/m, ν = 0.15.
+fn wool() -> Fabric {
+    let (config, _) = load_scene("tensile-warp", &[]).expect("bundled preset loads");
+    config.fabric.to_fabric().expect("bundled fabric is valid")
 }
 
-fn setup(linear: bool, bending: bool) -> (Model, State) {
-    let mesh = Mesh::rectangle(0.06, 0.04, 0.01, Pattern::Jittered, 7).unwrap();
-    let opts = PhysicsOptions { membrane: true, bending, gravity: DVec3::ZERO, damping: 0.0 };
-    let model = Model::new(&mesh, &wool(linear), 0.3, opts).unwrap();
-    let x: Vec<DVec3> = model.rest.iter().enumerate().map(|(i, p): (usize, &DVec2)| {
-        let k = i as f64;
-        DVec3::new(1.01 * p.x + 4e-4 * (1.3 * k).sin(), 0.995 * p.y + 3e-4 * (2.1 * k).cos(), 0.004 * (60.0 * p.x).sin() * (40.0 * p.y).cos() + 1e-3 * (0.7 * k).sin())
-    }).collect();
-    let mut s = State::at_rest(x);
-    for (i, v) in s.v.iter_mut().enumerate() {
-        let k = i as f64;
-        *v = DVec3::new(0.05 * (1.7 * k).sin() + 0.02, 0.04 * (2.3 * k).cos() - 0.01, 0.06 * (0.9 * k + 1.0).sin() + 0.03);
-    }
-    (model, s)
+/// The wool with its curves replaced by their initial slopes (1000 and 800 N/m), so that the
+/// membrane stiffness is the same in every state and a stability limit computed from the
+/// largest stiffness is the limit of every state, not only of the stiffest one.
+fn linear_wool() -> Fabric {
+    let mut fabric = wool();
+    fabric.tensile_warp = PiecewiseLinear::linear(1000.0);
+    fabric.tensile_weft = PiecewiseLinear::linear(800.0);
+    fabric
 }
 
-fn limit(model: &Model) -> f64 {
-    let rho = model.mass.iter().sum::<f64>() / model.vertex_area.iter().sum::<f64>();
-    model.mean_edge_length / (model.max_membrane_stiffness() / rho).sqrt()
+/// A free sheet (nothing pinned), no gravity, no damping.
+fn free_model(fabric: &Fabric, pattern: Pattern, edge: f64, bending: bool) -> Model {
+    let mesh = Mesh::rectangle(0.06, 0.04, edge, pattern, 7).unwrap();
+    let options = PhysicsOptions { membrane: true, bending, gravity: DVec3::ZERO, damping: 0.0 };
+    // Warp at 17° to the sample: nothing lines up with the mesh.
+    Model::new(&mesh, fabric, 17f64.to_radians(), options).unwrap()
 }
 
-fn energy(model: &Model, s: &State) -> f64 { s.kinetic_energy(model) + model.potential_energy(&s.x) }
-
-
-fn omega_max(model: &Model, x: &[DVec3]) -> f64 {
-    // power iteration on M^-1/2 K M^-1/2 with finite-difference K
-    let n = x.len();
-    let mut u: Vec<DVec3> = (0..n).map(|i| DVec3::new((1.1*i as f64).sin(), (2.3*i as f64).cos(), 0.3*(0.7*i as f64).sin())).collect();
-    let mut lam = 0.0;
-    for _ in 0..3000 {
-        let norm = u.iter().map(|v| v.length_squared()).sum::<f64>().sqrt();
-        for v in u.iter_mut() { *v /= norm; }
-        let d: Vec<DVec3> = (0..n).map(|i| u[i] / model.mass[i].sqrt()).collect();
-        let eps = 1e-7;
-        let xp: Vec<DVec3> = (0..n).map(|i| x[i] + eps * d[i]).collect();
-        let xm: Vec<DVec3> = (0..n).map(|i| x[i] - eps * d[i]).collect();
-        let (mut fp, mut fm) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-        model.forces(&xp, &mut fp); model.forces(&xm, &mut fm);
-        let w: Vec<DVec3> = (0..n).map(|i| -(fp[i] - fm[i]) / (2.0 * eps) / model.mass[i].sqrt()).collect();
-        lam = u.iter().zip(&w).map(|(a, b)| a.dot(*b)).sum::<f64>();
-        u = w;
-    }
-    lam.sqrt()
-}
-
-fn setup2(pattern: Pattern, smooth: bool) -> (Model, State) {
-    let mesh = Mesh::rectangle(0.06, 0.04, 0.005, pattern, 7).unwrap();
-    let opts = PhysicsOptions { membrane: true, bending: false, gravity: DVec3::ZERO, damping: 0.0 };
-    let model = Model::new(&mesh, &wool(true), 0.3, opts).unwrap();
-    let x: Vec<DVec3> = model.rest.iter().enumerate().map(|(i, p)| {
-        let k = i as f64;
-        let r = if smooth { 0.0 } else { 1.0 };
-        DVec3::new(1.01 * p.x + r*4e-4 * (1.3 * k).sin(), 0.995 * p.y + r*3e-4 * (2.1 * k).cos(), 0.004 * (60.0 * p.x).sin() * (40.0 * p.y).cos() + r*1e-3 * (0.7 * k).sin())
-    }).collect();
-    let mut s = State::at_rest(x);
-    for (i, v) in s.v.iter_mut().enumerate() {
+/// A crumpled, slightly stretched sheet centred on the origin, moving arbitrarily.
+/// `rough` adds an independent displacement and velocity to every vertex (energy in every
+/// mode, up to the mesh scale); without it the shape and velocity field are smooth.
+fn crumpled(model: &Model, rough: bool) -> State {
+    let r = if rough { 1.0 } else { 0.0 };
+    let centre = DVec2::new(0.03, 0.02);
+    let x = model
+        .rest
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            let k = i as f64;
+            let q = p - centre;
+            DVec3::new(
+                1.01 * q.x + r * 4e-4 * (1.3 * k).sin(),
+                0.995 * q.y + 0.05 * q.x * q.y + r * 3e-4 * (2.1 * k).cos(),
+                0.004 * (60.0 * p.x).sin() * (40.0 * p.y).cos() + 0.02 * q.x * q.x + r * 1e-3 * (0.7 * k).sin(),
+            )
+        })
+        .collect();
+    let mut state = State::at_rest(x);
+    for (i, v) in state.v.iter_mut().enumerate() {
         let k = i as f64;
         let p = model.rest[i];
-        *v = if smooth { DVec3::new(0.3 * (50.0*p.y).sin() + 0.02, 0.2*(40.0*p.x).cos(), 0.5 * (70.0*p.x + 30.0*p.y).sin()) }
-             else { DVec3::new(0.05 * (1.7 * k).sin() + 0.02, 0.04 * (2.3 * k).cos() - 0.01, 0.06 * (0.9 * k + 1.0).sin() + 0.03) };
+        // A drift, a spin about an oblique axis and a smooth wave, plus per-vertex noise.
+        let spin = DVec3::new(0.5, -1.0, 2.0).cross(state.x[i]);
+        let wave = DVec3::new(0.3 * (50.0 * p.y).sin(), 0.2 * (40.0 * p.x).cos(), 0.5 * (70.0 * p.x + 30.0 * p.y).sin());
+        let noise = DVec3::new(0.05 * (1.7 * k).sin(), 0.04 * (2.3 * k).cos(), 0.06 * (0.9 * k + 1.0).sin());
+        *v = DVec3::new(0.02, -0.01, 0.03) + spin + wave + r * noise;
     }
-    (model, s)
+    state
+}
+
+/// Explicit stability estimate: the fastest membrane wave, c = √(K_max/ρ_A), crossing one
+/// (mean) edge in a step.
+fn explicit_limit(model: &Model) -> f64 {
+    let areal_density = model.mass.iter().sum::<f64>() / model.vertex_area.iter().sum::<f64>();
+    model.mean_edge_length / (model.max_membrane_stiffness() / areal_density).sqrt()
+}
+
+/// Σ m|v|, the scale against which momentum round-off is judged, kg·m/s.
+fn momentum_scale(model: &Model, state: &State) -> f64 {
+    state.v.iter().zip(&model.mass).map(|(v, m)| m * v.length()).sum()
+}
+
+/// Σ m|x × v|, the scale for angular momentum, kg·m²/s.
+fn angular_momentum_scale(model: &Model, state: &State) -> f64 {
+    state.x.iter().zip(&state.v).zip(&model.mass).map(|((x, v), m)| m * x.cross(*v).length()).sum()
+}
+
+/// Steps `state` `steps` times; returns the worst relative linear and angular momentum errors.
+fn momentum_errors(model: &Model, integrator: &mut Integrator, state: &mut State, steps: usize) -> (f64, f64) {
+    let (p0, l0) = (state.momentum(model), state.angular_momentum(model));
+    let (mut worst_p, mut worst_l) = (0.0f64, 0.0f64);
+    for n in 0..steps {
+        integrator.step(model, state).unwrap_or_else(|e| panic!("{} step {n}: {e}", integrator.kind));
+        worst_p = worst_p.max((state.momentum(model) - p0).length() / momentum_scale(model, state));
+        worst_l = worst_l.max((state.angular_momentum(model) - l0).length() / angular_momentum_scale(model, state));
+    }
+    (worst_p, worst_l)
+}
+
+/// A stable step for each integrator: explicit at a fifth of its limit; the implicit ones at
+/// 1 ms, where they are stable and take a few Newton iterations per step.
+fn stable_dt(kind: IntegratorKind, model: &Model) -> f64 {
+    if kind.is_explicit() { 0.2 * explicit_limit(model) } else { 1e-3 }
+}
+
+/// Implicit steps with the linear systems solved to round-off. The default CG tolerance (1e-5)
+/// leaves a residual whose sum is a net force: with it the momentum leaks by ~1e-8 relative
+/// in 200 steps (see `implicit_integrators_conserve_momentum_with_default_solver_settings`).
+fn converged_integrator(kind: IntegratorKind, dt: f64) -> Integrator {
+    let mut integrator = Integrator::new(kind, dt);
+    if !kind.is_explicit() {
+        integrator.newton.cg_tolerance = 1e-13;
+        integrator.newton.cg_max_iterations = 20_000;
+    }
+    integrator
+}
+
+// ---------------------------------------------------------------------------------------
+// Momentum
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn every_integrator_conserves_linear_momentum_of_a_free_membrane() {
+    // The membrane forces are equal and opposite edge tensions, so they sum to zero exactly
+    // up to round-off; every integrator's update then conserves Σ m v.
+    let model = free_model(&wool(), Pattern::Jittered, 0.01, false);
+    for kind in IntegratorKind::ALL {
+        let mut state = crumpled(&model, true);
+        let mut integrator = converged_integrator(kind, stable_dt(kind, &model));
+        let (p, l) = momentum_errors(&model, &mut integrator, &mut state, 200);
+        eprintln!("{kind} (dt {:.3e} s): linear momentum error {p:.2e}, angular momentum error {l:.2e} (relative)", integrator.dt);
+        // 1e-12: round-off. Each step adds relative errors of order ε = 2.2e-16 (forces summed
+        // over a few neighbours; implicit velocities from position differences, ε|x|/(|v|Δt)
+        // ≈ 1e-13 here); 200 steps stay below 1e-12 unless something is not conserved.
+        assert!(p < 1e-12, "{kind}: linear momentum changed by {p:e} of Σm|v|");
+        if kind == IntegratorKind::SymplecticEuler {
+            // Symplectic Euler conserves L exactly for central and rotation-invariant forces:
+            // L' = Σ m x_n × v' (as x' − x_n ∥ v') = L + Δt Σ x_n × f(x_n) = L. 1e-9 of
+            // Σ m|x × v| is generous round-off.
+            assert!(l < 1e-9, "{kind}: angular momentum changed by {l:e} of Σm|x×v|");
+        }
+    }
 }
 
 #[test]
-fn explore2() {
-    for pattern in [Pattern::Regular, Pattern::Alternating, Pattern::Jittered, Pattern::Equilateral] {
-        for smooth in [false, true] {
-            let (model, s0) = setup2(pattern, smooth);
-            let lim = limit(&model);
-            let restx: Vec<DVec3> = model.rest.iter().map(|p| DVec3::new(p.x, p.y, 0.0)).collect();
-            let stretched: Vec<DVec3> = model.rest.iter().map(|p| DVec3::new(1.01*p.x, 1.01*p.y, 0.0)).collect();
-            let w = omega_max(&model, &stretched);
-            let _ = restx;
-            eprintln!("{pattern:?} smooth {smooth}: estimate {lim:e}, 2/omega_max {:e} (ratio {:.3})", 2.0 / w, 2.0 / w / lim);
-            for factor in [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7] {
-                let mut s = s0.clone();
-                let mut integ = Integrator::new(IntegratorKind::SymplecticEuler, factor * lim);
-                let e0 = energy(&model, &s);
-                let (mut lo, mut hi) = (e0, e0);
-                let mut res = String::from("ok");
-                for n in 0..2000 {
-                    match integ.step(&model, &mut s) { Ok(_) => {} Err(_) => { res = format!("diverged at step {n}"); break; } }
-                    let e = energy(&model, &s);
-                    lo = lo.min(e); hi = hi.max(e);
-                }
-                eprintln!("  factor {factor}: range [{:+.4}, {:+.4}] {res}", lo / e0 - 1.0, hi / e0 - 1.0);
+fn symplectic_euler_conserves_momentum_with_bending() {
+    // The bending energy ½ xᵀQx is invariant under translations and rotations (Q has zero row
+    // sums and is symmetric), so linear and angular momentum are conserved as well.
+    let model = free_model(&wool(), Pattern::Jittered, 0.01, true);
+    let mut state = crumpled(&model, true);
+    let mut integrator = Integrator::new(IntegratorKind::SymplecticEuler, stable_dt(IntegratorKind::SymplecticEuler, &model));
+    let (p, l) = momentum_errors(&model, &mut integrator, &mut state, 200);
+    eprintln!("symplectic-euler with bending: linear {p:.2e}, angular {l:.2e}");
+    // Tolerances as in the membrane test.
+    assert!(p < 1e-12, "linear momentum changed by {p:e} of Σm|v|");
+    assert!(l < 1e-9, "angular momentum changed by {l:e} of Σm|x×v|");
+}
+
+/// Runs both implicit integrators from the same start, prints their momentum errors and
+/// asserts the round-off bound on each.
+fn assert_implicit_momentum(model: &Model, label: &str, make: impl Fn(IntegratorKind, f64) -> Integrator) {
+    let errors: Vec<(IntegratorKind, f64)> = [IntegratorKind::ImplicitEuler, IntegratorKind::Bdf2]
+        .into_iter()
+        .map(|kind| {
+            let mut state = crumpled(model, true);
+            let mut integrator = make(kind, stable_dt(kind, model));
+            let (p, l) = momentum_errors(model, &mut integrator, &mut state, 200);
+            eprintln!("{kind}, {label}: linear momentum error {p:.2e}, angular {l:.2e} (relative)");
+            (kind, p)
+        })
+        .collect();
+    for (kind, p) in errors {
+        // Round-off, as in the membrane test.
+        assert!(p < 1e-12, "{kind}, {label}: linear momentum changed by {p:e} of Σm|v|");
+    }
+}
+
+#[test]
+#[ignore = "fails: 2.2e-12 (implicit Euler, BDF2) here, 9e-11 with the sheet moved 1.7 m away. \
+            Q's row sums are zero only to round-off (1e-12 N/m against entries up to 77 N/m), so Qx \
+            has a net force (~1e-15 N here) that grows with |x| and accumulates over simulated time"]
+fn implicit_integrators_conserve_momentum_with_bending() {
+    let model = free_model(&wool(), Pattern::Jittered, 0.01, true);
+    assert_implicit_momentum(&model, "bending on, converged solves", converged_integrator);
+}
+
+#[test]
+#[ignore = "fails: 8.8e-8 (implicit Euler). With the default CG tolerance (1e-5) the residual of \
+            each Newton solve sums to a net force, which changes Σ m v"]
+fn implicit_integrators_conserve_momentum_with_default_solver_settings() {
+    let model = free_model(&wool(), Pattern::Jittered, 0.01, false);
+    assert_implicit_momentum(&model, "default Newton settings", Integrator::new);
+}
+
+// ---------------------------------------------------------------------------------------
+// Energy and stability of the explicit integrator
+// ---------------------------------------------------------------------------------------
+
+/// Total energy at the time of the positions. Symplectic Euler as implemented (kick, then
+/// drift) is the leapfrog scheme: the stored velocity is the one that carried x_{n−1} to x_n,
+/// i.e. v at t_{n−½}. The velocity at t_n is v + (Δt/2)·f(x_n)/m.
+fn synchronized_energy(model: &Model, state: &State, dt: f64) -> f64 {
+    let mut f = vec![DVec3::ZERO; state.x.len()];
+    model.forces(&state.x, &mut f);
+    let kinetic: f64 = state.v.iter().zip(&f).zip(&model.mass).map(|((v, f), m)| 0.5 * m * (*v + 0.5 * dt * *f / *m).length_squared()).sum();
+    kinetic + model.potential_energy(&state.x)
+}
+
+/// Kinetic energy of the stored velocities plus potential energy.
+fn raw_energy(model: &Model, state: &State) -> f64 {
+    state.kinetic_energy(model) + model.potential_energy(&state.x)
+}
+
+#[test]
+fn symplectic_euler_keeps_energy_bounded_without_drift_at_half_its_limit() {
+    // Bending off: its explicit limit scales as h² and would set the step instead.
+    let model = free_model(&linear_wool(), Pattern::Alternating, 0.005, false);
+    let dt = 0.5 * explicit_limit(&model);
+    let mut integrator = Integrator::new(IntegratorKind::SymplecticEuler, dt);
+    // A smooth crumple and velocity field: the energy sits in resolved modes. (With
+    // per-vertex noise most of it sits in mesh-scale modes, for which this step is ω·Δt ≈ 1;
+    // no explicit method measures their energy to 5 % there.)
+    let mut state = crumpled(&model, false);
+    let e0 = synchronized_energy(&model, &state, dt);
+    let (mut low, mut high) = (e0, e0);
+    let (mut raw_low, mut raw_high) = (f64::INFINITY, 0.0f64);
+    let (mut first, mut last) = (0.0, 0.0);
+    const STEPS: usize = 2000;
+    const WINDOW: usize = 500;
+    for n in 0..STEPS {
+        integrator.step(&model, &mut state).unwrap_or_else(|e| panic!("step {n}: {e}"));
+        let e = synchronized_energy(&model, &state, dt);
+        low = low.min(e);
+        high = high.max(e);
+        let raw = raw_energy(&model, &state);
+        raw_low = raw_low.min(raw);
+        raw_high = raw_high.max(raw);
+        if n < WINDOW {
+            first += e / WINDOW as f64;
+        } else if n >= STEPS - WINDOW {
+            last += e / WINDOW as f64;
+        }
+    }
+    eprintln!(
+        "dt = {dt:.3e} s (0.5 × {:.3e} s): energy {e0:.4e} J, range [{:+.4}, {:+.4}], drift between first and last {WINDOW} steps {:+.4}; \
+         with the stored (half-step) velocities: [{:+.4}, {:+.4}]",
+        explicit_limit(&model),
+        low / e0 - 1.0,
+        high / e0 - 1.0,
+        last / first - 1.0,
+        raw_low / e0 - 1.0,
+        raw_high / e0 - 1.0
+    );
+    // 5 %: leapfrog conserves a modified energy exactly (linear case) and the energy within
+    // O((ω·Δt)²/4) of it, oscillating, never drifting.
+    assert!(low > 0.95 * e0 && high < 1.05 * e0, "energy left ±5 %: [{low:e}, {high:e}] J from {e0:e} J");
+    // No drift: the averages over the first and the last quarter of the run agree.
+    assert!((last / first - 1.0).abs() < 0.05, "energy drifted from {first:e} to {last:e} J");
+}
+
+#[test]
+fn symplectic_euler_far_beyond_its_limit_diverges_and_keeps_the_last_good_state() {
+    let model = free_model(&linear_wool(), Pattern::Alternating, 0.005, false);
+    let dt = 3.0 * explicit_limit(&model);
+    let mut integrator = Integrator::new(IntegratorKind::SymplecticEuler, dt);
+    let mut state = crumpled(&model, false);
+    for n in 0..2000 {
+        let before = state.clone();
+        match integrator.step(&model, &mut state) {
+            Ok(_) => assert!(state.x.iter().all(|x| x.is_finite())),
+            Err(error) => {
+                eprintln!("diverged at step {n}: {error}");
+                let StepError::Diverged { integrator: kind, dt: reported, time, .. } = &error;
+                assert_eq!(*kind, IntegratorKind::SymplecticEuler);
+                assert_eq!(*reported, dt);
+                assert_eq!(*time, before.time);
+                assert_eq!(state, before, "a rejected step must leave the state as it was");
+                assert!(state.x.iter().chain(&state.v).all(|p| p.is_finite()));
+                assert_eq!(state.steps, n as u64);
+                return;
             }
         }
     }
+    panic!("symplectic Euler at 3 × its stability limit (dt = {dt:e} s) ran 2000 steps without diverging");
 }
