@@ -79,10 +79,10 @@ fn worst_curve_error(label: &str, measured: &[[f64; 2]], input: &[[f64; 2]]) -> 
 ///
 /// 1 %: away from the grips a quasi-static strip is in uniaxial stress, where the membrane
 /// law reproduces the input curve exactly (its quadratic Poisson correction is built for
-/// that); what remains is the grips' lateral constraint, which reaches only a short way
-/// into a 2:1 strip at ν = 0.15, dynamic overshoot of a slow pull, and the rosette's
-/// geometric nonlinearity of order the strain squared. Together these should stay well
-/// under 1 % of the stress.
+/// that). What remains: the grips' lateral constraint, which stiffens the strip by at most
+/// ν_xy·ν_yx ≈ 2 % where the width is fully held and by far less at the extensometer; the
+/// dynamic overshoot of a slow pull; and the rosette's geometric nonlinearity, of order the
+/// strain squared. Together these should stay well under 1 % of the stress.
 fn assert_reproduces_input_curve(preset: &str, direction: &str, overrides: &[&str]) -> f64 {
     let (config, metrics) = run(preset, overrides);
     let input = match direction {
@@ -91,7 +91,13 @@ fn assert_reproduces_input_curve(preset: &str, direction: &str, overrides: &[&st
         other => panic!("unknown direction {other}"),
     };
     let label = format!("{preset} ({direction}, {})", config.solver.integrator);
-    let (worst, at) = worst_curve_error(&label, &stress_strain(&metrics), input);
+    let points = stress_strain(&metrics);
+    // The comparison must cover the whole pull, every knee included: the extensometer strain
+    // ends within the grips' few-percent effect of the clamp strain.
+    let max_strain = config.test.max_strain.unwrap();
+    let reached = points.iter().map(|p| p[0]).fold(0.0, f64::max);
+    assert!(reached > 0.9 * max_strain, "{label}: the pull reached ε = {reached}, not {max_strain}");
+    let (worst, at) = worst_curve_error(&label, &points, input);
     assert!(worst < 0.01, "{label}: measured stress is {:.2} % off the input curve at strain {at:.5}", 100.0 * worst);
     worst
 }
@@ -262,9 +268,10 @@ fn bias_pull(length: f64) -> (f64, f64, f64, f64) {
 fn bias_pull_follows_off_axis_modulus_and_poisson_ratio() {
     let (e, e45, nu, nu45) = bias_pull(0.25);
     // 3 %: the formula is uniaxial stress with free shear; the grips forbid the shear–extension
-    // coupling of an orthotropic sheet at 45° (E_x ≠ E_y) near the ends, and the rosette's
-    // geometric nonlinearity is of order the strain (1 %). A 5:1 strip keeps the grip zones
-    // out of the central extensometer half.
+    // coupling of an orthotropic sheet at 45° (E_x ≠ E_y) and the necking near the ends, and
+    // the rosette's geometric nonlinearity is of order the strain (1 %). A 5:1 strip keeps the
+    // grip zones out of the central extensometer half (the preset's 2:1 strip reads ν45 about
+    // 13 % high and E45 0.4 % high with these curves).
     assert!((e / e45 - 1.0).abs() < 0.03, "bias modulus {e} N/m, formula {e45} N/m");
     assert!((nu / nu45 - 1.0).abs() < 0.03, "bias Poisson ratio {nu}, formula {nu45}");
 }

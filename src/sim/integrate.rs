@@ -239,6 +239,7 @@ impl Integrator {
         let mut direction = vec![DVec3::ZERO; n];
         let mut trial = y.clone();
         let tolerance = self.newton.tolerance * model.mean_edge_length;
+        let all_free = !model.fixed.iter().any(|&f| f);
         let mut report = StepReport { newton_unconverged: true, ..Default::default() };
         for _ in 0..self.newton.max_iterations {
             self.forces.resize(n, DVec3::ZERO);
@@ -261,6 +262,19 @@ impl Integrator {
             let rhs: Vec<DVec3> = gradient.iter().map(|g| -*g).collect();
             let cg = pcg(&system, &rhs, &mut direction, self.newton.cg_tolerance, self.newton.cg_max_iterations);
             report.cg_iterations += cg.iterations;
+            if all_free {
+                // The elastic Hessian annihilates translations, so adding a constant c to d
+                // changes only the mass term of H d. Choosing c so that Σ M (d + c) = −Σ g
+                // removes the net force the CG residual would leave: momentum is then
+                // conserved to round-off whatever the CG tolerance.
+                let (mut mass_sum, mut residual) = (0.0, DVec3::ZERO);
+                for i in 0..n {
+                    mass_sum += mass_diagonal[i];
+                    residual += gradient[i] + mass_diagonal[i] * direction[i];
+                }
+                let shift = -residual / mass_sum;
+                direction.iter_mut().for_each(|d| *d += shift);
+            }
             report.newton_iterations += 1;
             let slope: f64 = gradient.iter().zip(&direction).map(|(g, d)| g.dot(*d)).sum();
             if slope >= 0.0 {

@@ -315,10 +315,12 @@ impl Model {
         }
         self.add_membrane_forces(x, f);
         if let Some(q) = &self.bending {
-            let mut qx = vec![DVec3::ZERO; x.len()];
-            q.multiply_add(x, &mut qx);
-            for (fi, q) in f.iter_mut().zip(qx) {
-                *fi -= q;
+            // f_a = −Σ_b Q_ab x_b written as −Σ_b Q_ab (x_b − x_a) (rows sum to zero): the
+            // same force, but independent of where the origin is, so it keeps its round-off
+            // small far from the origin.
+            for (a, fa) in f.iter_mut().enumerate() {
+                let xa = x[a];
+                *fa -= q.entries_of_row(a as u32).map(|(b, v)| v * (x[b as usize] - xa)).sum::<DVec3>();
             }
         }
     }
@@ -779,6 +781,22 @@ fn bending_matrix(n: usize, patches: &[BendingPatch], stiffness: &BendingStiffne
                 q.values[slot] += area * e;
             }
         }
+    }
+    // Exact symmetry and rows that sum to exactly zero (the energy ignores translations), so
+    // that round-off in the weights cannot leave a net force that drifts the momentum.
+    let entries: Vec<(u32, u32, f64)> = q.entries().collect();
+    for &(a, b, v) in &entries {
+        if a < b {
+            let mean = 0.5 * (v + q.values[q.slot(b, a)]);
+            let (ab, ba) = (q.slot(a, b), q.slot(b, a));
+            q.values[ab] = mean;
+            q.values[ba] = mean;
+        }
+    }
+    for row in 0..n as u32 {
+        let off_diagonal: f64 = q.entries_of_row(row).filter(|&(col, _)| col != row).map(|(_, v)| v).sum();
+        let diagonal = q.slot(row, row);
+        q.values[diagonal] = -off_diagonal;
     }
     q
 }

@@ -113,21 +113,10 @@ impl ScalarCsr {
         self.values[self.slot(row, row)]
     }
 
-    /// Drops entries that are zero (a pattern built generously, then trimmed once).
-    pub fn prune(self) -> Self {
-        let mut row_start = vec![0u32];
-        let mut cols = Vec::new();
-        let mut values = Vec::new();
-        for row in 0..self.row_start.len() - 1 {
-            for k in self.row_start[row] as usize..self.row_start[row + 1] as usize {
-                if self.values[k] != 0.0 || self.cols[k] as usize == row {
-                    cols.push(self.cols[k]);
-                    values.push(self.values[k]);
-                }
-            }
-            row_start.push(cols.len() as u32);
-        }
-        Self { row_start, cols, values }
+    /// The stored entries of one row as (col, value).
+    pub fn entries_of_row(&self, row: u32) -> impl Iterator<Item = (u32, f64)> + '_ {
+        let (s, e) = (self.row_start[row as usize] as usize, self.row_start[row as usize + 1] as usize);
+        (s..e).map(move |k| (self.cols[k], self.values[k]))
     }
 
     /// Iterates the stored entries as (row, col, value).

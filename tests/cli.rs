@@ -1,0 +1,239 @@
+//! Validates the `rosette` command line: preset listing, headless runs of every bundled
+//! scene with complete metrics, exit codes and messages for bad input (2) and divergence (3),
+//! and metrics on standard output.
+
+use rosette::scene::preset::SCENES;
+use rosette::scene::{Scene, load_scene};
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+use std::time::Instant;
+
+fn rosette(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rosette")).args(args).output().expect("the rosette binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// A fresh path for a metrics file, unique to the test.
+fn metrics_path(tag: &str) -> PathBuf {
+    let path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-{tag}-{}.json", std::process::id()));
+    let _ = std::fs::remove_file(&path);
+    path
+}
+
+/// The keys every metrics report carries.
+const KEYS: [&str; 11] = [
+    "preset",
+    "integrator",
+    "dt",
+    "vertices",
+    "triangles",
+    "simulated_seconds",
+    "steps",
+    "wall_seconds",
+    "cpu_seconds_per_simulated_second",
+    "stable",
+    "measures",
+];
+
+fn assert_has_keys(metrics: &Value, context: &str) {
+    for key in KEYS {
+        assert!(metrics.get(key).is_some(), "{context}: metrics lack '{key}': {metrics}");
+    }
+}
+
+#[test]
+fn presets_lists_every_bundled_scene() {
+    let out = rosette(&["presets"]);
+    assert!(out.status.success(), "exit {:?}: {}", out.status, text(&out.stderr));
+    let listed: Vec<String> =
+        text(&out.stdout).lines().filter_map(|l| l.split_whitespace().next()).map(str::to_string).collect();
+    let bundled: Vec<&str> = SCENES.iter().map(|s| s.name).collect();
+    assert_eq!(listed, bundled, "`rosette presets` must list the bundled scenes, in order");
+}
+
+// ---------------------------------------------------------------------------------------
+// Every bundled preset runs headless to completion
+// ---------------------------------------------------------------------------------------
+
+/// Runs `rosette run NAME --metrics FILE` and checks the report against the preset's own
+/// input data: its integrator and step, a run to the end of its duration, stable.
+fn run_bundled(name: &str) {
+    let (config, _) = load_scene(name, &[]).unwrap();
+    let scene = Scene::build(config.clone()).unwrap();
+    let path = metrics_path(name);
+    let started = Instant::now();
+    let out = rosette(&["run", name, "--metrics", path.to_str().unwrap()]);
+    let elapsed = started.elapsed().as_secs_f64();
+    eprintln!("rosette run {name}: {elapsed:.1} s wall");
+    assert_eq!(out.status.code(), Some(0), "{name}: {}", text(&out.stderr));
+    let metrics: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    std::fs::remove_file(&path).ok();
+    assert_has_keys(&metrics, name);
+    let dt = config.solver.dt;
+    let duration = config.scene.duration;
+    assert_eq!(metrics["preset"], name);
+    assert_eq!(metrics["integrator"], config.solver.integrator.name());
+    assert_eq!(metrics["dt"].as_f64(), Some(dt));
+    assert_eq!(metrics["stable"], true, "{name}: {}", metrics["error"]);
+    assert!(metrics.get("error").is_none(), "{name}: a stable run reports no error");
+    assert_eq!(metrics["vertices"].as_u64(), Some(scene.model.vertex_count() as u64));
+    assert_eq!(metrics["triangles"].as_u64(), Some(scene.model.triangle_count() as u64));
+    // The run covers the whole duration in whole steps of dt.
+    let steps = (duration / dt - 1e-9).ceil() as u64;
+    assert_eq!(metrics["steps"].as_u64(), Some(steps), "{name}");
+    let simulated = metrics["simulated_seconds"].as_f64().unwrap();
+    // Time is a running sum of dt: round-off of order steps·ε relative.
+    assert!((simulated - steps as f64 * dt).abs() < 1e-9 * duration, "{name}: simulated {simulated} s");
+    assert!(simulated >= duration - 1e-9 * duration, "{name}: stopped at {simulated} s of {duration} s");
+    let wall = metrics["wall_seconds"].as_f64().unwrap();
+    assert!(wall > 0.0 && wall <= elapsed, "{name}: wall_seconds {wall} outside (0, {elapsed}]");
+    let cpu = metrics["cpu_seconds_per_simulated_second"].as_f64().unwrap();
+    assert!(cpu.is_finite() && cpu > 0.0, "{name}: cpu_seconds_per_simulated_second {cpu}");
+    let measures = metrics["measures"].as_object().expect("measures is an object");
+    assert!(!measures.is_empty(), "{name}: no measurements");
+}
+
+/// Every bundled scene has its own test below (so that they run in parallel).
+const COVERED: [&str; 7] = ["tensile-warp", "tensile-weft", "tensile-bias", "cantilever", "arc", "euler-buckling", "shear-buckling"];
+
+#[test]
+fn every_bundled_scene_has_a_run_test() {
+    for scene in SCENES {
+        assert!(COVERED.contains(&scene.name), "bundled scene '{}' has no run test in tests/cli.rs", scene.name);
+    }
+}
+
+#[test]
+fn runs_tensile_warp() {
+    run_bundled("tensile-warp");
+}
+
+#[test]
+fn runs_tensile_weft() {
+    run_bundled("tensile-weft");
+}
+
+#[test]
+fn runs_tensile_bias() {
+    run_bundled("tensile-bias");
+}
+
+#[test]
+fn runs_cantilever() {
+    run_bundled("cantilever");
+}
+
+#[test]
+fn runs_arc() {
+    run_bundled("arc");
+}
+
+#[test]
+fn runs_euler_buckling() {
+    run_bundled("euler-buckling");
+}
+
+#[test]
+fn runs_shear_buckling() {
+    run_bundled("shear-buckling");
+}
+
+// ---------------------------------------------------------------------------------------
+// Bad input: exit 2 and a message that names the culprit
+// ---------------------------------------------------------------------------------------
+
+fn assert_bad_input(args: &[&str], must_name: &[&str]) {
+    let out = rosette(args);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: expected exit 2, stderr: {stderr}");
+    for word in must_name {
+        assert!(stderr.contains(word), "{args:?}: the message should name '{word}': {stderr}");
+    }
+}
+
+#[test]
+fn negative_areal_density_is_bad_input() {
+    assert_bad_input(&["run", "tensile-warp", "--set", "fabric.areal_density=-1"], &["fabric.areal_density", "-1"]);
+}
+
+#[test]
+fn unknown_key_is_bad_input() {
+    assert_bad_input(&["run", "tensile-warp", "--set", "fabric.densty=1"], &["densty"]);
+}
+
+#[test]
+fn unsorted_curve_is_bad_input() {
+    assert_bad_input(&["run", "tensile-warp", "--set", "fabric.tensile_warp=[[0,0],[0.02,5],[0.01,9]]"], &["tensile_warp", "sort"]);
+}
+
+#[test]
+fn unknown_preset_is_bad_input() {
+    // The message names what was asked for and lists what exists.
+    assert_bad_input(&["run", "no-such-scene"], &["no-such-scene", "tensile-warp"]);
+}
+
+#[test]
+fn unknown_integrator_is_bad_input() {
+    assert_bad_input(&["run", "tensile-warp", "--set", "solver.integrator=rk4"], &["rk4", "implicit-euler"]);
+}
+
+#[test]
+fn missing_scene_file_is_bad_input() {
+    let missing = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("no-such-dir").join("scene.toml");
+    let missing = missing.to_str().unwrap();
+    assert_bad_input(&["run", missing], &[missing]);
+}
+
+// ---------------------------------------------------------------------------------------
+// Divergence: exit 3, metrics still written
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn divergence_exits_3_and_still_writes_metrics() {
+    // 1 ms is about 70 times the explicit limit of this mesh (5 mm edges, c ≈ 340 m/s on the
+    // wool's stiffest segment: h/c ≈ 15 µs).
+    let path = metrics_path("diverged");
+    let out = rosette(&[
+        "run",
+        "tensile-warp",
+        "--set",
+        "solver.integrator=symplectic-euler",
+        "--set",
+        "solver.dt=0.001",
+        "--metrics",
+        path.to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "stderr: {stderr}");
+    assert!(stderr.contains("symplectic-euler"), "the message names the integrator: {stderr}");
+    assert!(stderr.contains("dt = 1e-3") || stderr.contains("dt = 0.001"), "the message names the step: {stderr}");
+    let metrics: Value = serde_json::from_str(&std::fs::read_to_string(&path).expect("metrics written")).unwrap();
+    std::fs::remove_file(&path).ok();
+    assert_has_keys(&metrics, "diverged run");
+    assert_eq!(metrics["stable"], false);
+    assert_eq!(metrics["integrator"], "symplectic-euler");
+    assert_eq!(metrics["dt"].as_f64(), Some(0.001));
+    assert!(metrics["error"].as_str().is_some_and(|e| e.contains("diverged")), "{}", metrics["error"]);
+    let (config, _) = load_scene("tensile-warp", &[]).unwrap();
+    let full = (config.scene.duration / 0.001).ceil() as u64;
+    assert!(metrics["steps"].as_u64().unwrap() < full, "the run stopped early");
+}
+
+// ---------------------------------------------------------------------------------------
+// Metrics on standard output
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn metrics_dash_writes_json_to_stdout() {
+    let out = rosette(&["run", "tensile-warp", "--metrics", "-"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let metrics: Value = serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("stdout is not one JSON document ({e}): {stdout}"));
+    assert_has_keys(&metrics, "--metrics -");
+    assert_eq!(metrics["preset"], "tensile-warp");
+    assert_eq!(metrics["stable"], true);
+}
