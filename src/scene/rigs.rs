@@ -229,12 +229,14 @@ impl Rig {
                     .map(|(_, p)| (p.x, p.z))
                     .collect();
                 let curvature = fit_circle_radius(&points).map_or(0.0, |radius| 1.0 / radius);
-                // Moment the cloth exerts on the grip about the grip line (its rest x = length),
-                // per unit width: what the grip's torque motor would read.
+                // Bending moment per unit width at the midspan section, where the curvature is
+                // fitted: by the balance of the half strip between it and the grip, it is the
+                // moment of the grip's forces about the midspan centre line. (About the grip
+                // line instead, any residual axial force would add itself times the arc's
+                // sagitta.)
                 let mut f = vec![DVec3::ZERO; state.x.len()];
                 model.forces(&state.x, &mut f);
-                let pivot_vertex = *r.grip.iter().min_by(|a, b| model.rest[**a as usize].x.total_cmp(&model.rest[**b as usize].x)).unwrap();
-                let pivot = state.x[pivot_vertex as usize];
+                let pivot = line[r.columns.nearest(0.5 * r.length)];
                 let torque: f64 = r.grip.iter().map(|&v| (state.x[v as usize] - pivot).cross(f[v as usize]).y).sum();
                 let moment = torque / r.width;
                 json!({
