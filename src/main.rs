@@ -58,11 +58,9 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Opt
             return ExitCode::from(EXIT_BAD_INPUT);
         }
     };
-    if let Some(d) = duration {
-        if !(d.is_finite() && d > 0.0) {
-            eprintln!("error: --duration must be a positive number of seconds, got {d}");
-            return ExitCode::from(EXIT_BAD_INPUT);
-        }
+    if let Some(d) = duration.filter(|d| !(d.is_finite() && *d > 0.0)) {
+        eprintln!("error: --duration must be a positive number of seconds, got {d}");
+        return ExitCode::from(EXIT_BAD_INPUT);
     }
     let mut scene = match Scene::build(config) {
         Ok(s) => s,

@@ -90,7 +90,7 @@ impl Scene {
     /// Advances one step and samples the rig's measurements on schedule.
     pub fn step(&mut self) -> Result<StepReport, StepError> {
         let report = self.integrator.step(&self.model, &mut self.state)?;
-        if self.state.steps % self.sample_every == 0 {
+        if self.state.steps.is_multiple_of(self.sample_every) {
             self.rig.sample(&self.model, &self.state);
         }
         Ok(report)

@@ -262,12 +262,10 @@ fn read_preset(kind: &'static str, spec: &str, list: &'static [Bundled], base: O
         return Ok((b.text.to_string(), Source::Bundled(b.name).label().replace("presets/", &format!("presets/{dir}"))));
     }
     let mut path = PathBuf::from(spec);
-    if path.is_relative() {
-        if let Some(base) = base {
-            let candidate = base.join(&path);
-            if candidate.exists() {
-                path = candidate;
-            }
+    if let (true, Some(base)) = (path.is_relative(), base) {
+        let candidate = base.join(&path);
+        if candidate.exists() {
+            path = candidate;
         }
     }
     if !path.exists() && !looks_like_path(spec) {

@@ -60,10 +60,8 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
                 break;
             }
         }
-        if let Some(p) = progress.as_deref_mut() {
-            if k % 16 == 0 {
-                p((k + 1) as f64 / steps as f64);
-            }
+        if let (Some(p), true) = (progress.as_deref_mut(), k.is_multiple_of(16)) {
+            p((k + 1) as f64 / steps as f64);
         }
     }
     let cpu_seconds = cpu.elapsed().as_secs_f64();

@@ -52,6 +52,8 @@ pub enum MeshError {
     Degenerate { triangle: usize, area: f64 },
     #[error("triangle {triangle} refers to vertex {vertex}, but the mesh has only {vertex_count} vertices")]
     BadIndex { triangle: usize, vertex: u32, vertex_count: usize },
+    #[error("triangle {triangle} is clockwise in the rest plane; list its vertices counter-clockwise")]
+    Clockwise { triangle: usize },
     #[error("edge {a}–{b} is shared by more than two triangles; cloth must be a manifold surface")]
     NonManifold { a: u32, b: u32 },
 }
@@ -204,8 +206,8 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// Checks indices and that no triangle is degenerate, and orients all triangles
-    /// counter-clockwise. Used for generated meshes and for meshes from files.
+    /// Checks indices, that no triangle is degenerate and that all are counter-clockwise.
+    /// Used for generated meshes and for meshes from files.
     pub fn validate(&self) -> Result<(), MeshError> {
         let vertex_count = self.rest.len();
         let scale = self.mean_edge_length().max(1e-12);
@@ -216,11 +218,12 @@ impl Mesh {
                 }
             }
             let area = self.signed_area(triangle);
-            if !(area.abs() > 1e-6 * scale * scale) {
+            // NaN areas (non-finite input) count as degenerate too.
+            if area.is_nan() || area.abs() <= 1e-6 * scale * scale {
                 return Err(MeshError::Degenerate { triangle, area });
             }
             if area < 0.0 {
-                return Err(MeshError::Degenerate { triangle, area });
+                return Err(MeshError::Clockwise { triangle });
             }
         }
         Ok(())
@@ -339,5 +342,7 @@ mod tests {
             triangles: vec![[0, 1, 3], [0, 1, 2]],
         };
         assert!(matches!(mesh.validate(), Err(MeshError::Degenerate { triangle: 1, .. })));
+        let flipped = Mesh { rest: mesh.rest.clone(), triangles: vec![[0, 1, 3], [0, 3, 1]] };
+        assert_eq!(flipped.validate(), Err(MeshError::Clockwise { triangle: 1 }));
     }
 }
