@@ -122,6 +122,10 @@ pub struct FabricConfig {
     /// Rigidity of a 45° strip, N·m; replaces eq. 3's middle term when given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bending_bias: Option<f64>,
+    /// Nonlinear bending: warp moment–curvature curve, [[1/m, N·m/m], ...]; its shape scales
+    /// the rigidities with curvature. Absent: linear bending.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_curve: Option<Vec<[f64; 2]>>,
 }
 
 impl FabricConfig {
@@ -140,6 +144,10 @@ impl FabricConfig {
             bending_warp: self.bending_warp,
             bending_weft: self.bending_weft,
             bending_bias: self.bending_bias,
+            bending_curve: match &self.bending_curve {
+                Some(points) => Some(curve("bending_curve", points)?),
+                None => None,
+            },
         };
         fabric.validate()?;
         Ok(fabric)

@@ -253,10 +253,11 @@ impl Integrator {
                 };
             }
             model.assemble_membrane_stiffness(&y, &mut stiffness);
+            let bending = model.bending_newton_matrix(&y);
             let system = SystemMatrix {
                 mass_diagonal: &mass_diagonal,
                 stiffness: &stiffness,
-                bending: model.bending_matrix(),
+                bending: bending.as_deref(),
                 fixed: &model.fixed,
             };
             let rhs: Vec<DVec3> = gradient.iter().map(|g| -*g).collect();

@@ -30,6 +30,11 @@ pub struct Fabric {
     pub bending_weft: f64,
     /// Measured rigidity of a strip cut at 45°, N·m; replaces eq. 3's middle term when given.
     pub bending_bias: Option<f64>,
+    /// Nonlinear bending: a warp moment–curvature curve, moment per unit width (N·m/m)
+    /// against curvature (1/m). Its shape (moments over its initial slope) scales the
+    /// rigidities with curvature in every direction; `bending_warp` keeps setting the
+    /// small-curvature rigidity. `None` is linear bending.
+    pub bending_curve: Option<PiecewiseLinear>,
 }
 
 /// A fabric property that is out of range, named by its preset key.
@@ -258,6 +263,7 @@ mod tests {
             bending_warp: 1e-5,
             bending_weft: 8e-6,
             bending_bias: None,
+            bending_curve: None,
         }
     }
 

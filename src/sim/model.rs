@@ -5,6 +5,7 @@
 //! sees the same conservative model. Everything that a scene switches off (membrane,
 //! bending, gravity) is absent from the model, not multiplied by zero.
 
+use crate::sim::curve::PiecewiseLinear;
 use crate::sim::material::{BendingStiffness, Fabric, FabricError, MembraneLaw};
 use crate::sim::mesh::{Mesh, MeshError};
 use crate::sim::sparse::{BlockCsr, ScalarCsr};
@@ -150,6 +151,9 @@ pub struct Model {
     bending: Option<ScalarCsr>,
     /// Per-triangle bending stencils (the Hessian x_,ij = Σ_a W_a x_a on each triangle).
     bending_patches: Vec<BendingPatch>,
+    /// Nonlinear bending: the normalised moment–curvature curve and, per triangle, its
+    /// (slot, value) contributions to Q, to assemble the secant Newton matrix.
+    bending_curve: Option<(PiecewiseLinear, Vec<Vec<(u32, f64)>>)>,
     /// Pattern of the in-plane stiffness matrix.
     stiffness_pattern: BlockCsr,
     /// Vertices whose positions are prescribed.
@@ -207,6 +211,10 @@ impl Model {
         } else {
             (None, Vec::new())
         };
+        let bending_curve = match (&bending, &fabric.bending_curve) {
+            (Some(q), Some(curve)) => Some((curve.clone(), triangle_contributions(q, &bending_patches, &bending_stiffness))),
+            _ => None,
+        };
         Ok(Self {
             options,
             rest: mesh.rest.clone(),
@@ -220,6 +228,7 @@ impl Model {
             bending_stiffness,
             bending,
             bending_patches,
+            bending_curve,
             stiffness_pattern,
             fixed: vec![false; n],
             anchor: vec![DVec3::ZERO; n],
@@ -264,7 +273,11 @@ impl Model {
         }
         let mesh = Mesh { rest: self.rest.clone(), triangles: self.triangles.clone() };
         let patches = bending_patches(&mesh, self.warp_angle, rigid)?;
-        self.bending = Some(bending_matrix(self.rest.len(), &patches, &self.bending_stiffness));
+        let q = bending_matrix(self.rest.len(), &patches, &self.bending_stiffness);
+        if let Some((_, contributions)) = &mut self.bending_curve {
+            *contributions = triangle_contributions(&q, &patches, &self.bending_stiffness);
+        }
+        self.bending = Some(q);
         self.bending_patches = patches;
         Ok(())
     }
@@ -283,9 +296,7 @@ impl Model {
                 energy += tri.area * law.energy(strain);
             }
         }
-        if let Some(q) = &self.bending {
-            energy += 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>();
-        }
+        energy += self.bending_energy(x);
         if self.options.gravity != DVec3::ZERO {
             energy -= x.iter().zip(&self.mass).map(|(p, m)| m * self.options.gravity.dot(*p)).sum::<f64>();
         }
@@ -298,11 +309,61 @@ impl Model {
             Some(law) => self.rosettes.iter().map(|tri| tri.area * law.energy(rosette_strain(tri, x).0)).sum(),
             None => 0.0,
         };
-        let bending = match &self.bending {
-            Some(q) => 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>(),
-            None => 0.0,
-        };
-        (membrane, bending)
+        (membrane, self.bending_energy(x))
+    }
+
+    /// Bending energy, J: ½ xᵀQx, or with a moment–curvature curve Σ_T A_T B_x Φ̂(κ_eq),
+    /// where κ_eq = √(2ψ_lin/B_x) is the warp curvature that stores the triangle's linear
+    /// energy density ψ_lin and Φ̂ is the curve's energy over its initial slope (so that a
+    /// bend along the warp follows the measured moments exactly).
+    fn bending_energy(&self, x: &[DVec3]) -> f64 {
+        let Some(q) = &self.bending else { return 0.0 };
+        match &self.bending_curve {
+            None => 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>(),
+            Some((curve, _)) => {
+                let b_ref = self.bending_stiffness.d11;
+                let slope = curve.initial_slope();
+                self.bending_patches
+                    .iter()
+                    .map(|patch| {
+                        let density = linear_bending_density(&self.bending_stiffness, &patch.hessian(x));
+                        let kappa = (2.0 * density / b_ref).sqrt();
+                        patch.area * b_ref * curve.integral(kappa) / slope
+                    })
+                    .sum()
+            }
+        }
+    }
+
+    /// Secant factor M(κ)/(M'(0) κ) of each triangle: how much its bending is stiffer (> 1)
+    /// or softer (< 1) than linear. All ones for linear bending.
+    fn bending_secants(&self, x: &[DVec3]) -> Vec<f64> {
+        let Some((curve, _)) = &self.bending_curve else { return vec![1.0; self.bending_patches.len()] };
+        let b_ref = self.bending_stiffness.d11;
+        let slope = curve.initial_slope();
+        self.bending_patches
+            .iter()
+            .map(|patch| {
+                let kappa = (2.0 * linear_bending_density(&self.bending_stiffness, &patch.hessian(x)) / b_ref).sqrt();
+                if kappa * 1e6 < 1.0 { 1.0 } else { curve.value(kappa) / (slope * kappa) }
+            })
+            .collect()
+    }
+
+    /// The bending part of Newton's matrix at `x`: Q itself for linear bending, otherwise
+    /// the secant matrix Σ_T s_T A_T WᵀDW (positive semi-definite; the curvature-derivative
+    /// term is left out, so Newton converges linearly rather than quadratically there).
+    pub fn bending_newton_matrix(&self, x: &[DVec3]) -> Option<std::borrow::Cow<'_, ScalarCsr>> {
+        let q = self.bending.as_ref()?;
+        let Some((_, contributions)) = &self.bending_curve else { return Some(std::borrow::Cow::Borrowed(q)) };
+        let mut secant = q.clone();
+        secant.values.fill(0.0);
+        for (s, entries) in self.bending_secants(x).iter().zip(contributions) {
+            for &(slot, value) in entries {
+                secant.values[slot as usize] += s * value;
+            }
+        }
+        Some(std::borrow::Cow::Owned(secant))
     }
 
     /// Total conservative force −∇E on every vertex, N (overwrites `f`).
@@ -314,7 +375,17 @@ impl Model {
             }
         }
         self.add_membrane_forces(x, f);
-        if let Some(q) = &self.bending {
+        if let (Some(_), Some(_)) = (&self.bending, &self.bending_curve) {
+            // Nonlinear: each triangle's linear force scaled by its secant factor.
+            let d = self.bending_stiffness.voigt();
+            for (patch, s) in self.bending_patches.iter().zip(self.bending_secants(x)) {
+                let h = patch.hessian(x);
+                let moment: [DVec3; 3] = [0, 1, 2].map(|i| d[i][0] * h[0] + d[i][1] * h[1] + d[i][2] * h[2]);
+                for (v, w) in patch.vertices.iter().zip(&patch.weights) {
+                    f[*v as usize] -= patch.area * s * (w[0] * moment[0] + w[1] * moment[1] + w[2] * moment[2]);
+                }
+            }
+        } else if let Some(q) = &self.bending {
             // f_a = −Σ_b Q_ab x_b written as −Σ_b Q_ab (x_b − x_a) (rows sum to zero): the
             // same force, but independent of where the origin is, so it keeps its round-off
             // small far from the origin.
@@ -416,11 +487,6 @@ impl Model {
         self.stiffness_pattern.clone()
     }
 
-    /// The constant bending matrix Q (energy ½ Σ Q_ab x_a·x_b), if bending is on.
-    pub fn bending_matrix(&self) -> Option<&ScalarCsr> {
-        self.bending.as_ref()
-    }
-
     /// Curvature `[κ_xx, κ_yy, κ_xy]` (1/m, warp frame) of every triangle, signed by the
     /// triangle's normal (x_,ij · n). Empty when bending is off.
     pub fn triangle_curvatures(&self, x: &[DVec3]) -> Vec<[f64; 3]> {
@@ -436,22 +502,9 @@ impl Model {
             .collect()
     }
 
-    /// Bending energy of each triangle's patch, J (they sum to the total bending energy).
+    /// Linear bending energy of each triangle's patch, J (they sum to ½ xᵀQx).
     pub fn triangle_bending_energies(&self, x: &[DVec3]) -> Vec<f64> {
-        let d = self.bending_stiffness.voigt();
-        self.bending_patches
-            .iter()
-            .map(|patch| {
-                let h = patch.hessian(x);
-                let mut e = 0.0;
-                for i in 0..3 {
-                    for j in 0..3 {
-                        e += d[i][j] * h[i].dot(h[j]);
-                    }
-                }
-                0.5 * patch.area * e
-            })
-            .collect()
+        self.bending_patches.iter().map(|patch| patch.area * linear_bending_density(&self.bending_stiffness, &patch.hessian(x))).collect()
     }
 
     /// Whether triangle `t` has a neighbour across each of its edges.
@@ -761,6 +814,41 @@ impl BendingPatch {
     }
 }
 
+/// Linear bending energy density ½ Σ_ij D_ij h_i·h_j of a triangle with Hessian `h`, J/m².
+fn linear_bending_density(stiffness: &BendingStiffness, h: &[DVec3; 3]) -> f64 {
+    let d = stiffness.voigt();
+    let mut e = 0.0;
+    for i in 0..3 {
+        for j in 0..3 {
+            e += d[i][j] * h[i].dot(h[j]);
+        }
+    }
+    0.5 * e
+}
+
+/// Each triangle's (slot, value) share of Q, for re-weighting by secant factors.
+fn triangle_contributions(q: &ScalarCsr, patches: &[BendingPatch], stiffness: &BendingStiffness) -> Vec<Vec<(u32, f64)>> {
+    let d = stiffness.voigt();
+    patches
+        .iter()
+        .map(|p| {
+            let mut out = Vec::with_capacity(p.vertices.len() * p.vertices.len());
+            for (a, wa) in p.vertices.iter().zip(&p.weights) {
+                for (b, wb) in p.vertices.iter().zip(&p.weights) {
+                    let mut e = 0.0;
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            e += wa[i] * d[i][j] * wb[j];
+                        }
+                    }
+                    out.push((q.slot(*a, *b) as u32, p.area * e));
+                }
+            }
+            out
+        })
+        .collect()
+}
+
 /// Q = Σ_T A_T Wᵀ 𝔻 W, the constant Hessian of the quadratic bending energy.
 fn bending_matrix(n: usize, patches: &[BendingPatch], stiffness: &BendingStiffness) -> ScalarCsr {
     let d = stiffness.voigt();
@@ -818,6 +906,7 @@ mod tests {
             bending_warp: 1.2e-5,
             bending_weft: 0.8e-5,
             bending_bias: None,
+            bending_curve: None,
         }
     }
 
@@ -827,9 +916,13 @@ mod tests {
 
     #[test]
     fn forces_are_minus_the_energy_gradient() {
-        for pattern in [Pattern::Alternating, Pattern::Jittered] {
+        let mut nonlinear = test_fabric();
+        // Stiffening, then softening moment–curvature knees (initial slope = bending_warp).
+        nonlinear.bending_curve =
+            Some(PiecewiseLinear::new_material(&[[0.0, 0.0], [2.0, 2.4e-5], [5.0, 1.2e-4], [9.0, 1.5e-4]]).unwrap());
+        for (pattern, fabric) in [(Pattern::Alternating, test_fabric()), (Pattern::Jittered, test_fabric()), (Pattern::Alternating, nonlinear)] {
             let mesh = Mesh::rectangle(0.04, 0.03, 0.01, pattern, 3).unwrap();
-            let model = Model::new(&mesh, &test_fabric(), 0.4, PhysicsOptions::default()).unwrap();
+            let model = Model::new(&mesh, &fabric, 0.4, PhysicsOptions::default()).unwrap();
             let x = deformed(&model, |p| {
                 DVec3::new(p.x * 1.02 + 0.003 * p.y, p.y * 0.99, 0.2 * p.x * p.x + 0.1 * p.x * p.y + 0.001 * (p.y * 300.0).sin())
             });
