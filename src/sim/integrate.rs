@@ -103,7 +103,7 @@ pub struct NewtonSettings {
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { max_iterations: 30, tolerance: 1e-5, cg_tolerance: 1e-4, cg_max_iterations: 3000 }
+        Self { max_iterations: 30, tolerance: 1e-5, cg_tolerance: 1e-3, cg_max_iterations: 3000 }
     }
 }
 
@@ -241,6 +241,7 @@ impl Integrator {
         let tolerance = self.newton.tolerance * model.mean_edge_length;
         let all_free = !model.fixed.iter().any(|&f| f);
         let mut report = StepReport { newton_unconverged: true, ..Default::default() };
+        let mut phi_current: Option<f64> = None;
         for _ in 0..self.newton.max_iterations {
             self.forces.resize(n, DVec3::ZERO);
             model.forces(&y, &mut self.forces);
@@ -286,20 +287,23 @@ impl Integrator {
                 }
             }
             let slope: f64 = gradient.iter().zip(&direction).map(|(g, d)| g.dot(*d)).sum();
-            let phi0 = objective(&y);
+            // Φ at the current iterate is the previous iteration's accepted trial value.
+            let phi0 = *phi_current.get_or_insert_with(|| objective(&y));
             let mut alpha = 1.0;
             let mut accepted = false;
+            let mut phi = phi0;
             for _ in 0..30 {
                 for i in 0..n {
                     trial[i] = y[i] + alpha * direction[i];
                 }
-                let phi = objective(&trial);
+                phi = objective(&trial);
                 if phi.is_finite() && phi <= phi0 + 1e-4 * alpha * slope {
                     accepted = true;
                     break;
                 }
                 alpha *= 0.5;
             }
+            phi_current = Some(phi).filter(|_| accepted);
             let step_size = alpha * direction.iter().map(|d| d.length()).fold(0.0, f64::max);
             if !accepted {
                 // Φ cannot be decreased measurably: at round-off level we are converged;
