@@ -156,7 +156,13 @@ impl Integrator {
         };
         next.time = state.time + self.dt;
         next.steps = state.steps + 1;
-        self.check(model, &next, state.time)?;
+        if let Err(StepError::Diverged { integrator, dt, time, mut reason }) = self.check(model, &next, state.time) {
+            if self.kind.is_explicit() {
+                let limit = model.explicit_step_limit(&state.x);
+                reason += &format!("; this explicit method is stable here only below dt ≈ {limit:.3e} s");
+            }
+            return Err(StepError::Diverged { integrator, dt, time, reason });
+        }
         *state = next;
         Ok(report)
     }
