@@ -10,7 +10,7 @@ pub use preset::{SceneConfig, SceneKind, load_scene};
 pub use run::{Metrics, RunOptions, run_scene};
 
 use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rigs::Rig;
 use thiserror::Error;
@@ -99,10 +99,5 @@ impl Scene {
     /// The rig's measurements as JSON.
     pub fn measures(&self) -> serde_json::Value {
         self.rig.finish(&self.model, &self.state)
-    }
-
-    /// Rest positions as 2D points (for placing things by rest coordinates).
-    pub fn rest(&self) -> &[DVec2] {
-        &self.model.rest
     }
 }

@@ -1,6 +1,5 @@
 //! Geometry helpers shared by the strip rigs: vertex columns, the centre line, circle fits.
 
-use crate::sim::Model;
 use glam::{DVec2, DVec3};
 
 /// Vertices grouped into columns by rest x (bins of half the grid spacing, so that the
@@ -105,43 +104,6 @@ pub fn count_half_waves(values: &[f64], fraction: f64) -> usize {
         }
     }
     count
-}
-
-/// Tributary width of each vertex along a line of vertices sorted by `y`, m.
-pub fn tributary_widths(ys: &[f64]) -> Vec<f64> {
-    let n = ys.len();
-    (0..n)
-        .map(|i| {
-            let lo = if i == 0 { ys[0] } else { 0.5 * (ys[i - 1] + ys[i]) };
-            let hi = if i + 1 == n { ys[n - 1] } else { 0.5 * (ys[i] + ys[i + 1]) };
-            hi - lo
-        })
-        .collect()
-}
-
-/// For each vertex of `end`, the neighbour joined to it by the edge pointing most nearly
-/// along −x in the rest state (the vertex "behind" it on the strip).
-pub fn inner_neighbours(model: &Model, end: &[u32]) -> Vec<u32> {
-    end.iter()
-        .map(|&v| {
-            let mut best = (f64::NEG_INFINITY, v);
-            for &[a, b] in &model.edges {
-                let other = if a == v {
-                    b
-                } else if b == v {
-                    a
-                } else {
-                    continue;
-                };
-                let d = model.rest[v as usize] - model.rest[other as usize];
-                let score = d.x / d.length();
-                if score > best.0 {
-                    best = (score, other);
-                }
-            }
-            best.1
-        })
-        .collect()
 }
 
 #[cfg(test)]
