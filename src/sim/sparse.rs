@@ -113,6 +113,12 @@ impl ScalarCsr {
         self.values[self.slot(row, row)]
     }
 
+    /// Entry (row, col), zero where the pattern has none.
+    pub fn value(&self, row: u32, col: u32) -> f64 {
+        let (s, e) = (self.row_start[row as usize] as usize, self.row_start[row as usize + 1] as usize);
+        self.cols[s..e].binary_search(&col).map_or(0.0, |k| self.values[s + k])
+    }
+
     /// The stored entries of one row as (col, value).
     pub fn entries_of_row(&self, row: u32) -> impl Iterator<Item = (u32, f64)> + '_ {
         let (s, e) = (self.row_start[row as usize] as usize, self.row_start[row as usize + 1] as usize);
@@ -148,6 +154,17 @@ impl SystemMatrix<'_> {
         }
     }
 
+    /// The preconditioner: incomplete Cholesky on the in-plane pattern, or block Jacobi if
+    /// that factorisation breaks down even with a diagonal shift.
+    fn preconditioner(&self) -> Preconditioner {
+        for shift in [0.0, 1e-3, 1e-2, 1e-1] {
+            if let Some(factor) = IncompleteCholesky::new(self, shift) {
+                return Preconditioner::IncompleteCholesky(factor);
+            }
+        }
+        Preconditioner::BlockJacobi(self.block_jacobi())
+    }
+
     /// Inverse 3×3 diagonal blocks: the block-Jacobi preconditioner.
     fn block_jacobi(&self) -> Vec<DMat3> {
         (0..self.fixed.len())
@@ -161,6 +178,141 @@ impl SystemMatrix<'_> {
                 block.inverse()
             })
             .collect()
+    }
+}
+
+enum Preconditioner {
+    BlockJacobi(Vec<DMat3>),
+    IncompleteCholesky(IncompleteCholesky),
+}
+
+impl Preconditioner {
+    fn apply(&self, r: &[DVec3], z: &mut [DVec3]) {
+        match self {
+            Preconditioner::BlockJacobi(blocks) => {
+                for i in 0..r.len() {
+                    z[i] = blocks[i] * r[i];
+                }
+            }
+            Preconditioner::IncompleteCholesky(factor) => factor.solve(r, z),
+        }
+    }
+}
+
+/// Incomplete Cholesky factor L (A ≈ L Lᵀ) of the system matrix restricted to the in-plane
+/// (one-ring) pattern, as scalars over the 3n unknowns, lower triangle by rows; the
+/// diagonal is each row's last entry. The bending matrix's wider entries are left out of
+/// the factor (they are still in the matrix CG solves with). Written by hand: the pattern
+/// is the mesh's, and no sparse-factorisation crate we could use takes it as it is.
+struct IncompleteCholesky {
+    row_start: Vec<usize>,
+    cols: Vec<u32>,
+    values: Vec<f64>,
+}
+
+impl IncompleteCholesky {
+    /// Factors A + shift·diag(A); None if a pivot is not positive (breakdown).
+    fn new(a: &SystemMatrix, shift: f64) -> Option<Self> {
+        let n = a.fixed.len();
+        let k = a.stiffness;
+        let mut row_start = Vec::with_capacity(3 * n + 1);
+        let mut cols: Vec<u32> = Vec::new();
+        let mut values: Vec<f64> = Vec::new();
+        row_start.push(0);
+        for vertex in 0..n {
+            let (s, e) = (k.row_start[vertex] as usize, k.row_start[vertex + 1] as usize);
+            for c in 0..3 {
+                let row = 3 * vertex + c;
+                if a.fixed[vertex] {
+                    cols.push(row as u32);
+                    values.push(1.0);
+                    row_start.push(cols.len());
+                    continue;
+                }
+                for slot in s..e {
+                    let other = k.cols[slot] as usize;
+                    if a.fixed[other] || other > vertex {
+                        continue;
+                    }
+                    let q = a.bending.map_or(0.0, |q| q.value(vertex as u32, other as u32));
+                    let block = k.values[slot];
+                    for d in 0..3 {
+                        let col = 3 * other + d;
+                        if col > row {
+                            continue;
+                        }
+                        let mut v = block.col(d)[c];
+                        if d == c {
+                            v += q;
+                            if other == vertex {
+                                v = (v + a.mass_diagonal[vertex]) * (1.0 + shift);
+                            }
+                        }
+                        cols.push(col as u32);
+                        values.push(v);
+                    }
+                }
+                row_start.push(cols.len());
+            }
+        }
+        // Rows are built in increasing column order because the block columns are sorted.
+        let mut factor = Self { row_start, cols, values };
+        for i in 0..3 * n {
+            let (s, e) = (factor.row_start[i], factor.row_start[i + 1]);
+            for p in s..e {
+                let k = factor.cols[p] as usize;
+                // Σ_j L_ij L_kj over the columns j < k the two rows share.
+                let (ks, ke) = (factor.row_start[k], factor.row_start[k + 1]);
+                let (mut x, mut y, mut sum) = (s, ks, 0.0);
+                while x < p && y < ke - 1 {
+                    let (cx, cy) = (factor.cols[x], factor.cols[y]);
+                    if cx == cy {
+                        sum += factor.values[x] * factor.values[y];
+                        x += 1;
+                        y += 1;
+                    } else if cx < cy {
+                        x += 1;
+                    } else {
+                        y += 1;
+                    }
+                }
+                if k == i {
+                    let pivot = factor.values[p] - sum;
+                    if !(pivot > 0.0) {
+                        return None;
+                    }
+                    factor.values[p] = pivot.sqrt();
+                } else {
+                    factor.values[p] = (factor.values[p] - sum) / factor.values[ke - 1];
+                }
+            }
+        }
+        Some(factor)
+    }
+
+    /// z = (L Lᵀ)⁻¹ r.
+    fn solve(&self, r: &[DVec3], z: &mut [DVec3]) {
+        let n = 3 * r.len();
+        let mut y: Vec<f64> = r.iter().flat_map(|v| v.to_array()).collect();
+        for i in 0..n {
+            let (s, e) = (self.row_start[i], self.row_start[i + 1]);
+            let mut v = y[i];
+            for p in s..e - 1 {
+                v -= self.values[p] * y[self.cols[p] as usize];
+            }
+            y[i] = v / self.values[e - 1];
+        }
+        for i in (0..n).rev() {
+            let (s, e) = (self.row_start[i], self.row_start[i + 1]);
+            y[i] /= self.values[e - 1];
+            let yi = y[i];
+            for p in s..e - 1 {
+                y[self.cols[p] as usize] -= self.values[p] * yi;
+            }
+        }
+        for (i, zi) in z.iter_mut().enumerate() {
+            *zi = DVec3::new(y[3 * i], y[3 * i + 1], y[3 * i + 2]);
+        }
     }
 }
 
@@ -179,14 +331,15 @@ fn dot(a: &[DVec3], b: &[DVec3]) -> f64 {
 /// `tolerance · |b|`. `A` must be symmetric positive definite on the free vertices.
 pub fn pcg(a: &SystemMatrix, b: &[DVec3], x: &mut [DVec3], tolerance: f64, max_iterations: usize) -> CgReport {
     let n = b.len();
-    let preconditioner = a.block_jacobi();
+    let preconditioner = a.preconditioner();
     x.fill(DVec3::ZERO);
     let mut r: Vec<DVec3> = b.iter().zip(a.fixed).map(|(&v, &f)| if f { DVec3::ZERO } else { v }).collect();
     let b_norm = dot(&r, &r).sqrt();
     if b_norm == 0.0 {
         return CgReport { iterations: 0, relative_residual: 0.0 };
     }
-    let mut z: Vec<DVec3> = (0..n).map(|i| preconditioner[i] * r[i]).collect();
+    let mut z = vec![DVec3::ZERO; n];
+    preconditioner.apply(&r, &mut z);
     let mut p = z.clone();
     let mut ap = vec![DVec3::ZERO; n];
     let mut rz = dot(&r, &z);
@@ -208,9 +361,7 @@ pub fn pcg(a: &SystemMatrix, b: &[DVec3], x: &mut [DVec3], tolerance: f64, max_i
         if residual <= tolerance {
             break;
         }
-        for i in 0..n {
-            z[i] = preconditioner[i] * r[i];
-        }
+        preconditioner.apply(&r, &mut z);
         let rz_next = dot(&r, &z);
         let beta = rz_next / rz;
         rz = rz_next;
