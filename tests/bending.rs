@@ -209,3 +209,23 @@ fn arc_follows_a_nonlinear_moment_curvature_curve() {
     println!("nonlinear arc: κ = {kappa:.3} 1/m, moment {moment:.4e} vs curve {expected:.4e} ({:.2} %)", error * 100.0);
     assert!(error < 0.01, "{moment} vs {expected}");
 }
+
+/// Settling detection stops a static test early without changing its answer: the
+/// cantilever preset watches for settling (RMS speed below 0.1 mm/s for 0.2 s), stops well
+/// before its 3 s, and its tip drop matches a run of the full duration to 0.1 %.
+#[test]
+fn settled_cantilever_stops_early_with_the_same_answer() {
+    let (config, _) = load_scene("cantilever", &[]).unwrap();
+    let mut settling = Scene::build(config.clone()).unwrap();
+    let (early, _) = run_scene(&mut settling, "cantilever", RunOptions { duration: None, progress: None });
+    let mut full_config = config;
+    full_config.scene.settle_speed = None;
+    let mut full = Scene::build(full_config).unwrap();
+    let (complete, _) = run_scene(&mut full, "cantilever", RunOptions { duration: None, progress: None });
+    assert_eq!(early.settled, Some(true));
+    assert_eq!(complete.settled, None);
+    assert!(early.simulated_seconds < 0.7 * complete.simulated_seconds, "{} s vs {} s", early.simulated_seconds, complete.simulated_seconds);
+    let (a, b) = (early.measures["tip_drop"].as_f64().unwrap(), complete.measures["tip_drop"].as_f64().unwrap());
+    println!("settled at {:?} s: tip drop {a} vs {b} after the full {} s", early.settle_time, complete.simulated_seconds);
+    assert!((a - b).abs() < 1e-3 * b);
+}

@@ -82,13 +82,23 @@ fn run_bundled(name: &str) {
     assert!(metrics.get("error").is_none(), "{name}: a stable run reports no error");
     assert_eq!(metrics["vertices"].as_u64(), Some(scene.model.vertex_count() as u64));
     assert_eq!(metrics["triangles"].as_u64(), Some(scene.model.triangle_count() as u64));
-    // The run covers the whole duration in whole steps of dt.
-    let steps = (duration / dt - 1e-9).ceil() as u64;
-    assert_eq!(metrics["steps"].as_u64(), Some(steps), "{name}");
+    // The run covers the whole duration in whole steps of dt, unless it watched for settling
+    // and stopped once the cloth had stayed slow for the settling window.
+    let full_steps = (duration / dt - 1e-9).ceil() as u64;
+    let steps = metrics["steps"].as_u64().unwrap();
     let simulated = metrics["simulated_seconds"].as_f64().unwrap();
     // Time is a running sum of dt: round-off of order steps·ε relative.
     assert!((simulated - steps as f64 * dt).abs() < 1e-9 * duration, "{name}: simulated {simulated} s");
-    assert!(simulated >= duration - 1e-9 * duration, "{name}: stopped at {simulated} s of {duration} s");
+    match metrics["settled"].as_bool() {
+        Some(true) => {
+            let settle_time = metrics["settle_time"].as_f64().unwrap();
+            assert!(steps <= full_steps && settle_time < simulated, "{name}: settled at {settle_time} s, stopped at {simulated} s");
+        }
+        _ => {
+            assert_eq!(steps, full_steps, "{name}");
+            assert!(simulated >= duration - 1e-9 * duration, "{name}: stopped at {simulated} s of {duration} s");
+        }
+    }
     let wall = metrics["wall_seconds"].as_f64().unwrap();
     assert!(wall > 0.0 && wall <= elapsed, "{name}: wall_seconds {wall} outside (0, {elapsed}]");
     let cpu = metrics["cpu_seconds_per_simulated_second"].as_f64().unwrap();

@@ -90,6 +90,18 @@ pub struct SceneSection {
     /// Seed of the random perturbation.
     #[serde(default)]
     pub seed: u64,
+    /// Stop early once the cloth has settled: the RMS vertex speed stays below this, m/s,
+    /// for `settle_window` seconds after every prescribed motion has finished. Absent: run
+    /// the whole duration.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settle_speed: Option<f64>,
+    /// How long the cloth must stay slow to count as settled, s.
+    #[serde(default = "default_settle_window")]
+    pub settle_window: f64,
+}
+
+fn default_settle_window() -> f64 {
+    0.2
 }
 
 /// A fabric as written in a preset: SI units per unit width.
@@ -362,6 +374,10 @@ fn check_scene(c: &SceneConfig) -> Result<(), String> {
         if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("{key} must be a positive number, got {v}")) }
     };
     positive("scene.duration", c.scene.duration)?;
+    positive("scene.settle_window", c.scene.settle_window)?;
+    if let Some(v) = c.scene.settle_speed {
+        positive("scene.settle_speed", v)?;
+    }
     positive("solver.dt", c.solver.dt)?;
     positive("mesh.edge_length", c.mesh.edge_length)?;
     if !(c.solver.damping >= 0.0 && c.solver.damping.is_finite()) {

@@ -22,6 +22,13 @@ pub struct Metrics {
     /// CPU seconds per 10 ms simulated, the unit of the paper's Table 1.
     pub cpu_seconds_per_10ms: f64,
     pub stable: bool,
+    /// Whether the run stopped early because the cloth settled (absent when settling is
+    /// not watched: `scene.settle_speed` unset).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub settled: Option<bool>,
+    /// Time at which the cloth settled, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub settle_time: Option<f64>,
     /// Why the run stopped early, if it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -49,6 +56,11 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let start_time = scene.state.time;
     let (mut newton, mut cg) = (0u64, 0u64);
     let mut error = None;
+    let settle_speed = scene.config.scene.settle_speed;
+    let settle_window = scene.config.scene.settle_window;
+    let total_mass: f64 = scene.model.mass.iter().sum();
+    // Start of the current run of slow steps, and when the cloth settled.
+    let (mut slow_since, mut settle_time): (Option<f64>, Option<f64>) = (None, None);
     for k in 0..steps {
         match scene.step() {
             Ok(report) => {
@@ -58,6 +70,20 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             Err(e) => {
                 error = Some(e);
                 break;
+            }
+        }
+        if let Some(limit) = settle_speed {
+            let t = scene.state.time;
+            // Mass-weighted RMS speed: √(2 KE / M).
+            let rms = (2.0 * scene.state.kinetic_energy(&scene.model) / total_mass).sqrt();
+            if rms < limit && scene.model.motions_finished(t) {
+                let since = *slow_since.get_or_insert(t);
+                if t - since >= settle_window {
+                    settle_time = Some(since);
+                    break;
+                }
+            } else {
+                slow_since = None;
             }
         }
         if let (Some(p), true) = (progress.as_deref_mut(), k.is_multiple_of(16)) {
@@ -79,6 +105,8 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         cpu_seconds_per_simulated_second: per_second,
         cpu_seconds_per_10ms: per_second * 0.01,
         stable: error.is_none(),
+        settled: settle_speed.map(|_| settle_time.is_some()),
+        settle_time,
         error: error.as_ref().map(|e| e.to_string()),
         newton_iterations: newton,
         cg_iterations: cg,

@@ -282,6 +282,14 @@ impl Model {
         Ok(())
     }
 
+    /// Whether every prescribed motion has come to rest by time `t`.
+    pub fn motions_finished(&self, t: f64) -> bool {
+        self.motions.iter().all(|m| match *m {
+            Motion::Linear { stop, .. } | Motion::Swing { stop, .. } => t >= stop,
+            Motion::Roll { ramp, .. } => t >= ramp,
+        })
+    }
+
     /// Prescribed position of a fixed vertex at time `t`.
     pub fn prescribed_position(&self, v: usize, t: f64) -> DVec3 {
         self.motions[self.driver[v] as usize].position(self.anchor[v], t)
