@@ -255,22 +255,6 @@ pub enum ShearKinematics {
     Simple,
 }
 
-/// Where a preset came from: a bundled name or a file.
-#[derive(Debug, Clone)]
-enum Source {
-    Bundled(&'static str),
-    File(PathBuf),
-}
-
-impl Source {
-    fn label(&self) -> String {
-        match self {
-            Source::Bundled(name) => format!("presets/{name}.toml (bundled)"),
-            Source::File(p) => p.display().to_string(),
-        }
-    }
-}
-
 fn looks_like_path(spec: &str) -> bool {
     spec.contains('/') || spec.contains('\\') || spec.ends_with(".toml")
 }
@@ -279,7 +263,7 @@ fn read_preset(kind: &'static str, spec: &str, list: &'static [Bundled], base: O
     let bundled = list.iter().find(|b| b.name == spec);
     if let (Some(b), false) = (bundled, looks_like_path(spec)) {
         let dir = if kind == "fabric" { "fabrics/" } else { "" };
-        return Ok((b.text.to_string(), Source::Bundled(b.name).label().replace("presets/", &format!("presets/{dir}"))));
+        return Ok((b.text.to_string(), format!("presets/{dir}{}.toml (bundled)", b.name)));
     }
     let mut path = PathBuf::from(spec);
     if let (true, Some(base)) = (path.is_relative(), base) {
@@ -293,7 +277,7 @@ fn read_preset(kind: &'static str, spec: &str, list: &'static [Bundled], base: O
         return Err(PresetError::Unknown { kind, name: spec.to_string(), available });
     }
     let text = std::fs::read_to_string(&path).map_err(|source| PresetError::Io { path: path.display().to_string(), source })?;
-    Ok((text, Source::File(path).label()))
+    Ok((text, path.display().to_string()))
 }
 
 fn parse_table(text: &str, file: &str) -> Result<toml::Table, PresetError> {
@@ -418,12 +402,9 @@ fn check_scene(c: &SceneConfig) -> Result<(), String> {
         }
         SceneKind::Cantilever => {}
     }
-    match c.scene.kind {
-        SceneKind::Tensile | SceneKind::Cantilever | SceneKind::Arc | SceneKind::EulerBuckling | SceneKind::ShearBuckling => {
-            positive("cloth.length", c.cloth.length)?;
-            positive("cloth.width", c.cloth.width)?;
-        }
-    }
+    // Every laboratory scene so far is a rectangular strip.
+    positive("cloth.length", c.cloth.length)?;
+    positive("cloth.width", c.cloth.width)?;
     Ok(())
 }
 
