@@ -98,22 +98,23 @@ impl Motion {
                 };
                 end + (anchor.x - length) * DVec3::new(phi.cos(), 0.0, phi.sin()) + DVec3::new(0.0, 0.0, anchor.z)
             }
-            _ => anchor + self.displacement(t),
+            Motion::Linear { velocity, start, stop } => anchor + velocity * (t - start).clamp(0.0, (stop - start).max(0.0)),
+            Motion::Swing { radius, angular_speed, stop } => {
+                let a = angular_speed * t.clamp(0.0, stop);
+                anchor + DVec3::new(radius * a.sin(), radius * (a.cos() - 1.0), 0.0)
+            }
         }
     }
 
     pub const STILL: Motion = Motion::Linear { velocity: DVec3::ZERO, start: 0.0, stop: 0.0 };
+}
 
-    pub fn displacement(&self, t: f64) -> DVec3 {
-        match *self {
-            Motion::Linear { velocity, start, stop } => velocity * (t - start).clamp(0.0, (stop - start).max(0.0)),
-            Motion::Swing { radius, angular_speed, stop } => {
-                let a = angular_speed * t.clamp(0.0, stop);
-                DVec3::new(radius * a.sin(), radius * (a.cos() - 1.0), 0.0)
-            }
-            Motion::Roll { .. } => unreachable!("a roll moves each vertex differently; use position()"),
-        }
-    }
+/// Nonlinear bending data: the warp moment–curvature curve and each triangle's
+/// (slot, value) share of Q, re-weighted by secant factors into Newton's matrix.
+#[derive(Debug, Clone)]
+struct NonlinearBending {
+    curve: PiecewiseLinear,
+    contributions: Vec<Vec<(u32, f64)>>,
 }
 
 /// Rest data of one triangle's strain rosette (paper Fig. 1).
@@ -151,9 +152,8 @@ pub struct Model {
     bending: Option<ScalarCsr>,
     /// Per-triangle bending stencils (the Hessian x_,ij = Σ_a W_a x_a on each triangle).
     bending_patches: Vec<BendingPatch>,
-    /// Nonlinear bending: the normalised moment–curvature curve and, per triangle, its
-    /// (slot, value) contributions to Q, to assemble the secant Newton matrix.
-    bending_curve: Option<(PiecewiseLinear, Vec<Vec<(u32, f64)>>)>,
+    /// Nonlinear bending, when the fabric has a moment–curvature curve.
+    bending_curve: Option<NonlinearBending>,
     /// Pattern of the in-plane stiffness matrix.
     stiffness_pattern: BlockCsr,
     /// Vertices whose positions are prescribed.
@@ -205,17 +205,13 @@ impl Model {
             Vec::new()
         };
         let bending_stiffness = BendingStiffness::new(fabric)?;
-        let (bending, bending_patches) = if options.bending {
-            let patches = bending_patches(mesh, warp_angle, &vec![false; n])?;
-            (Some(bending_matrix(n, &patches, &bending_stiffness)), patches)
-        } else {
-            (None, Vec::new())
-        };
-        let bending_curve = match (&bending, &fabric.bending_curve) {
-            (Some(q), Some(curve)) => Some((curve.clone(), triangle_contributions(q, &bending_patches, &bending_stiffness))),
-            _ => None,
-        };
-        Ok(Self {
+        // Filled in by `build_bending` below when bending is on.
+        let bending_curve = fabric
+            .bending_curve
+            .clone()
+            .filter(|_| options.bending)
+            .map(|curve| NonlinearBending { curve, contributions: Vec::new() });
+        let mut model = Self {
             options,
             rest: mesh.rest.clone(),
             triangles: mesh.triangles.clone(),
@@ -226,8 +222,8 @@ impl Model {
             membrane_law,
             rosettes,
             bending_stiffness,
-            bending,
-            bending_patches,
+            bending: None,
+            bending_patches: Vec::new(),
             bending_curve,
             stiffness_pattern,
             fixed: vec![false; n],
@@ -235,7 +231,11 @@ impl Model {
             driver: vec![0; n],
             motions: vec![Motion::STILL],
             edges: edge_set,
-        })
+        };
+        if options.bending {
+            model.build_bending(&vec![false; n])?;
+        }
+        Ok(model)
     }
 
     pub fn vertex_count(&self) -> usize {
@@ -268,14 +268,17 @@ impl Model {
     /// pinned or driven together). Bending stencils are rebuilt so that they do not fit
     /// across the clamp line (see `bending_patches`).
     pub fn set_clamped_region(&mut self, rigid: &[bool]) -> Result<(), ModelError> {
-        if self.bending.is_none() {
-            return Ok(());
-        }
+        if self.options.bending { self.build_bending(rigid) } else { Ok(()) }
+    }
+
+    /// Builds the bending stencils, Q and (for nonlinear bending) each triangle's share of
+    /// Q, with `rigid` marking clamped vertices.
+    fn build_bending(&mut self, rigid: &[bool]) -> Result<(), ModelError> {
         let mesh = Mesh { rest: self.rest.clone(), triangles: self.triangles.clone() };
         let patches = bending_patches(&mesh, self.warp_angle, rigid)?;
         let q = bending_matrix(self.rest.len(), &patches, &self.bending_stiffness);
-        if let Some((_, contributions)) = &mut self.bending_curve {
-            *contributions = triangle_contributions(&q, &patches, &self.bending_stiffness);
+        if let Some(nonlinear) = &mut self.bending_curve {
+            nonlinear.contributions = triangle_contributions(&q, &patches, &self.bending_stiffness);
         }
         self.bending = Some(q);
         self.bending_patches = patches;
@@ -328,34 +331,30 @@ impl Model {
         let Some(q) = &self.bending else { return 0.0 };
         match &self.bending_curve {
             None => 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>(),
-            Some((curve, _)) => {
+            Some(NonlinearBending { curve, .. }) => {
                 let b_ref = self.bending_stiffness.d11;
-                let slope = curve.initial_slope();
                 self.bending_patches
                     .iter()
                     .map(|patch| {
-                        let density = linear_bending_density(&self.bending_stiffness, &patch.hessian(x));
-                        let kappa = (2.0 * density / b_ref).sqrt();
-                        patch.area * b_ref * curve.integral(kappa) / slope
+                        let kappa = self.equivalent_curvature(&patch.hessian(x));
+                        patch.area * b_ref * curve.integral(kappa) / curve.initial_slope()
                     })
                     .sum()
             }
         }
     }
 
-    /// Secant factor M(κ)/(M'(0) κ) of each triangle: how much its bending is stiffer (> 1)
-    /// or softer (< 1) than linear. All ones for linear bending.
-    fn bending_secants(&self, x: &[DVec3]) -> Vec<f64> {
-        let Some((curve, _)) = &self.bending_curve else { return vec![1.0; self.bending_patches.len()] };
-        let b_ref = self.bending_stiffness.d11;
-        let slope = curve.initial_slope();
-        self.bending_patches
-            .iter()
-            .map(|patch| {
-                let kappa = (2.0 * linear_bending_density(&self.bending_stiffness, &patch.hessian(x)) / b_ref).sqrt();
-                if kappa * 1e6 < 1.0 { 1.0 } else { curve.value(kappa) / (slope * kappa) }
-            })
-            .collect()
+    /// κ_eq = √(2ψ_lin/B_x): the warp curvature storing the linear energy density of a
+    /// triangle whose Hessian is `h`, 1/m.
+    fn equivalent_curvature(&self, h: &[DVec3; 3]) -> f64 {
+        (2.0 * linear_bending_density(&self.bending_stiffness, h) / self.bending_stiffness.d11).sqrt()
+    }
+
+    /// Secant factor M(κ)/(M'(0) κ): how much stiffer (> 1) or softer (< 1) than linear a
+    /// triangle with Hessian `h` bends under `curve`.
+    fn bending_secant(&self, curve: &PiecewiseLinear, h: &[DVec3; 3]) -> f64 {
+        let kappa = self.equivalent_curvature(h);
+        if kappa * 1e6 < 1.0 { 1.0 } else { curve.value(kappa) / (curve.initial_slope() * kappa) }
     }
 
     /// The bending part of Newton's matrix at `x`: Q itself for linear bending, otherwise
@@ -363,10 +362,11 @@ impl Model {
     /// term is left out, so Newton converges linearly rather than quadratically there).
     pub fn bending_newton_matrix(&self, x: &[DVec3]) -> Option<std::borrow::Cow<'_, ScalarCsr>> {
         let q = self.bending.as_ref()?;
-        let Some((_, contributions)) = &self.bending_curve else { return Some(std::borrow::Cow::Borrowed(q)) };
+        let Some(NonlinearBending { curve, contributions }) = &self.bending_curve else { return Some(std::borrow::Cow::Borrowed(q)) };
         let mut secant = q.clone();
         secant.values.fill(0.0);
-        for (s, entries) in self.bending_secants(x).iter().zip(contributions) {
+        for (patch, entries) in self.bending_patches.iter().zip(contributions) {
+            let s = self.bending_secant(curve, &patch.hessian(x));
             for &(slot, value) in entries {
                 secant.values[slot as usize] += s * value;
             }
@@ -383,11 +383,12 @@ impl Model {
             }
         }
         self.add_membrane_forces(x, f);
-        if let (Some(_), Some(_)) = (&self.bending, &self.bending_curve) {
+        if let (Some(_), Some(NonlinearBending { curve, .. })) = (&self.bending, &self.bending_curve) {
             // Nonlinear: each triangle's linear force scaled by its secant factor.
             let d = self.bending_stiffness.voigt();
-            for (patch, s) in self.bending_patches.iter().zip(self.bending_secants(x)) {
+            for patch in &self.bending_patches {
                 let h = patch.hessian(x);
+                let s = self.bending_secant(curve, &h);
                 let moment: [DVec3; 3] = [0, 1, 2].map(|i| d[i][0] * h[0] + d[i][1] * h[1] + d[i][2] * h[2]);
                 for (v, w) in patch.vertices.iter().zip(&patch.weights) {
                     f[*v as usize] -= patch.area * s * (w[0] * moment[0] + w[1] * moment[1] + w[2] * moment[2]);

@@ -110,7 +110,7 @@ impl ScalarCsr {
     }
 
     pub fn diagonal(&self, row: u32) -> f64 {
-        self.values[self.slot(row, row)]
+        self.value(row, row)
     }
 
     /// Entry (row, col), zero where the pattern has none.
@@ -278,7 +278,7 @@ impl IncompleteCholesky {
                 }
                 if k == i {
                     let pivot = factor.values[p] - sum;
-                    if !(pivot > 0.0) {
+                    if pivot.is_nan() || pivot <= 0.0 {
                         return None;
                     }
                     factor.values[p] = pivot.sqrt();
