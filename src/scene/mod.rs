@@ -2,6 +2,7 @@
 //! One registry (`preset::SCENES`) feeds the command line, the tests and the viewer.
 
 pub mod preset;
+pub mod props;
 pub mod rigs;
 pub mod run;
 pub mod strip;
@@ -30,6 +31,8 @@ pub struct Scene {
     pub state: State,
     pub integrator: Integrator,
     pub rig: Rig,
+    /// Rigid props the cloth collides with.
+    pub props: Vec<crate::sim::contact::Prop>,
     /// Steps between measurement samples.
     sample_every: u64,
 }
@@ -40,6 +43,7 @@ pub const GRAVITY: f64 = 9.81;
 impl Scene {
     pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
         let fabric = config.fabric.to_fabric().map_err(ModelError::from)?;
+        let props = props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
         let options = PhysicsOptions {
             membrane: config.physics.membrane,
             bending: config.physics.bending,
@@ -84,7 +88,7 @@ impl Scene {
         integrator.newton = config.solver.newton;
         let steps = (config.scene.duration / config.solver.dt).ceil().max(1.0) as u64;
         let sample_every = (steps / 400).max(1);
-        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, sample_every })
+        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every })
     }
 
     /// Advances one step and samples the rig's measurements on schedule.

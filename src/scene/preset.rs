@@ -76,6 +76,83 @@ pub struct SceneConfig {
     pub physics: PhysicsSection,
     #[serde(default)]
     pub test: TestSection,
+    /// Contact settings (props, friction, self-collision).
+    #[serde(default)]
+    pub contact: ContactSection,
+    /// Rigid props: `[[props]]` tables.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub props: Vec<PropConfig>,
+    /// Directory of the scene file, for relative asset paths (none for bundled scenes).
+    #[serde(skip)]
+    pub base_dir: Option<PathBuf>,
+}
+
+/// Contact with props and between folds of the cloth.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContactSection {
+    /// Distance the cloth keeps from a prop's surface, m.
+    pub thickness: f64,
+    /// Coulomb friction coefficient while sticking.
+    pub friction_static: f64,
+    /// Coulomb friction coefficient while sliding (at most the static one).
+    pub friction_kinetic: f64,
+    /// Cloth–cloth contact in folds. Off where the cloth cannot touch itself.
+    pub self_collision: bool,
+    /// Distance kept between cloth layers, m; absent: the smaller of the prop thickness
+    /// and a fifth of the edge length.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub self_thickness: Option<f64>,
+    /// Contact penalty stiffness as a multiple of m/Δt² per vertex (implicit solvers).
+    pub stiffness: f64,
+}
+
+impl Default for ContactSection {
+    fn default() -> Self {
+        Self { thickness: 0.002, friction_static: 0.5, friction_kinetic: 0.4, self_collision: false, self_thickness: None, stiffness: 100.0 }
+    }
+}
+
+/// The kinds of prop a scene can place.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PropKind {
+    Ground,
+    Box,
+    Cylinder,
+    Sphere,
+    Mesh,
+}
+
+/// One `[[props]]` table. Which size keys are needed depends on `shape`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PropConfig {
+    pub shape: PropKind,
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Centre of the prop (a point of the ground plane), m.
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Rotation about x, then y, then z, degrees.
+    #[serde(default)]
+    pub rotation_deg: [f64; 3],
+    /// Cylinder and sphere radius, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Cylinder height, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height: Option<f64>,
+    /// Box size along x, y, z, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size: Option<[f64; 3]>,
+    /// Mesh: OBJ file, a bundled asset name (e.g. `assets/bowl.obj`) or a path relative to
+    /// the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// Mesh: uniform scale applied to the file's coordinates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f64>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -341,8 +418,9 @@ pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, Stri
         fabric.insert(k, v);
     }
     table.insert("fabric".into(), toml::Value::Table(fabric));
-    let config: SceneConfig =
+    let mut config: SceneConfig =
         table.try_into().map_err(|e: toml::de::Error| PresetError::Invalid { file: file.clone(), message: describe(&e) })?;
+    config.base_dir = base;
     config.fabric.to_fabric().map_err(|source| PresetError::Fabric { file: file.clone(), source })?;
     check_scene(&config).map_err(|message| PresetError::Invalid { file: file.clone(), message })?;
     Ok((config, file))

@@ -1,5 +1,6 @@
 //! The physics: meshes, fabric laws, the model's energies and the time integrators.
 //! No rendering, UI or file input/output here.
+pub mod contact;
 pub mod curve;
 pub mod integrate;
 pub mod material;

@@ -1,0 +1,77 @@
+//! Props from scene files: `[[props]]` tables turned into the simulator's parry3d props,
+//! with OBJ meshes read from the bundled assets or from disk.
+
+use super::preset::{PropConfig, PropKind};
+use crate::sim::contact::{Prop, PropShape};
+use glam::{DQuat, DVec3, EulerRot};
+use std::path::Path;
+
+/// An asset file bundled into the binary.
+pub struct Asset {
+    pub name: &'static str,
+    pub text: &'static str,
+}
+
+/// Bundled meshes, addressed by their path under the repository (`assets/cushion.obj`).
+pub const ASSETS: &[Asset] = &[Asset { name: "assets/cushion.obj", text: include_str!("../../assets/cushion.obj") }];
+
+/// Builds every prop of a scene; errors name the prop and the key to fix.
+pub fn build_props(configs: &[PropConfig], base_dir: Option<&Path>) -> Result<Vec<Prop>, String> {
+    configs.iter().enumerate().map(|(i, c)| build_prop(i, c, base_dir)).collect()
+}
+
+fn build_prop(index: usize, c: &PropConfig, base_dir: Option<&Path>) -> Result<Prop, String> {
+    let name = c.name.clone().unwrap_or_else(|| format!("props[{index}] ({:?})", c.shape).to_lowercase());
+    let need = |key: &str, v: Option<f64>| v.ok_or_else(|| format!("prop '{name}': a {:?} needs `{key}`", c.shape).to_lowercase());
+    let shape = match c.shape {
+        PropKind::Ground => PropShape::Ground,
+        PropKind::Box => {
+            let size = c.size.ok_or_else(|| format!("prop '{name}': a box needs `size = [x, y, z]` in metres"))?;
+            PropShape::Box { half_extents: 0.5 * DVec3::from_array(size) }
+        }
+        PropKind::Cylinder => PropShape::Cylinder { radius: need("radius", c.radius)?, height: need("height", c.height)? },
+        PropKind::Sphere => PropShape::Sphere { radius: need("radius", c.radius)? },
+        PropKind::Mesh => {
+            let file = c.file.as_deref().ok_or_else(|| format!("prop '{name}': a mesh needs `file`, an OBJ path"))?;
+            let scale = c.scale.unwrap_or(1.0);
+            if !(scale.is_finite() && scale > 0.0) {
+                return Err(format!("prop '{name}': scale must be positive, got {scale}"));
+            }
+            let (vertices, triangles) = load_obj(file, base_dir).map_err(|e| format!("prop '{name}': {e}"))?;
+            PropShape::Mesh { vertices: vertices.into_iter().map(|v| v * scale).collect(), triangles }
+        }
+    };
+    let [rx, ry, rz] = c.rotation_deg.map(f64::to_radians);
+    let rotation = DQuat::from_euler(EulerRot::ZYX, rz, ry, rx);
+    Prop::new(&name, shape, DVec3::from_array(c.position), rotation).map_err(|e| e.to_string())
+}
+
+/// Reads an OBJ (all its objects, triangulated) from a bundled asset or a file.
+pub fn load_obj(file: &str, base_dir: Option<&Path>) -> Result<(Vec<DVec3>, Vec<[u32; 3]>), String> {
+    let text = match ASSETS.iter().find(|a| a.name == file) {
+        Some(asset) => asset.text.to_string(),
+        None => {
+            let mut path = Path::new(file).to_path_buf();
+            if let (true, Some(base)) = (path.is_relative(), base_dir) {
+                path = base.join(path);
+            }
+            std::fs::read_to_string(&path).map_err(|e| {
+                let bundled: Vec<_> = ASSETS.iter().map(|a| a.name).collect();
+                format!("cannot read {}: {e} (bundled meshes: {})", path.display(), bundled.join(", "))
+            })?
+        }
+    };
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Ok(Default::default()))
+        .map_err(|e| format!("{file} is not a readable OBJ: {e}"))?;
+    let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
+    for m in models {
+        let offset = vertices.len() as u32;
+        vertices.extend(m.mesh.positions.chunks_exact(3).map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)));
+        triangles.extend(m.mesh.indices.chunks_exact(3).map(|t| [t[0] + offset, t[1] + offset, t[2] + offset]));
+    }
+    if triangles.is_empty() {
+        return Err(format!("{file} has no faces"));
+    }
+    Ok((vertices, triangles))
+}

@@ -1,0 +1,4 @@
+//! Contact: cloth against rigid props and cloth against itself.
+pub mod props;
+
+pub use props::{Prop, PropError, PropShape, SurfacePoint};

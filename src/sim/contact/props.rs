@@ -1,0 +1,224 @@
+//! Rigid props (table, pedestal, ball, floor, meshes) as parry3d shapes.
+//!
+//! This is the one place where the simulator's f64 `DVec3` meets parry3d's f32 `Vec3`:
+//! every query converts on the way in and out. f32 is ample for contact geometry at the
+//! scale of a room (about 3e-8 m resolution at 1 m); the cloth itself stays in f64.
+
+use glam::{DQuat, DVec3, Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::query::Ray;
+use parry3d::shape::{Ball, Cuboid, Cylinder, HalfSpace, SharedShape, TriMesh, TriMeshFlags};
+use thiserror::Error;
+
+fn to_f32(v: DVec3) -> Vec3 {
+    v.as_vec3()
+}
+
+fn to_f64(v: Vec3) -> DVec3 {
+    v.as_dvec3()
+}
+
+/// The geometric kinds of prop, in the simulator's z-up world.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PropShape {
+    /// The half-space below a horizontal plane through the prop's position.
+    Ground,
+    /// A box with these half-extents along its local x, y, z.
+    Box { half_extents: DVec3 },
+    /// A cylinder around its local z axis.
+    Cylinder { radius: f64, height: f64 },
+    Sphere { radius: f64 },
+    /// A closed, outward-oriented triangle mesh, in local coordinates.
+    Mesh { vertices: Vec<DVec3>, triangles: Vec<[u32; 3]> },
+}
+
+#[derive(Debug, Error)]
+pub enum PropError {
+    #[error("prop '{name}': {message}")]
+    Invalid { name: String, message: String },
+}
+
+/// A rigid, static prop.
+#[derive(Clone)]
+pub struct Prop {
+    pub name: String,
+    pub shape: PropShape,
+    /// Position of the prop's centre (the plane's point for the ground), m.
+    pub position: DVec3,
+    /// Orientation of the prop's local axes.
+    pub rotation: DQuat,
+    collider: SharedShape,
+    pose: Pose,
+}
+
+impl std::fmt::Debug for Prop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Prop").field("name", &self.name).field("shape", &self.shape).field("position", &self.position).finish()
+    }
+}
+
+/// The nearest surface point of a prop to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    /// Signed distance, m: negative inside the prop.
+    pub distance: f64,
+    /// The closest point on the surface.
+    pub point: DVec3,
+    /// Outward unit normal of the contact plane there.
+    pub normal: DVec3,
+}
+
+impl Prop {
+    pub fn new(name: &str, shape: PropShape, position: DVec3, rotation: DQuat) -> Result<Self, PropError> {
+        let invalid = |message: String| PropError::Invalid { name: name.to_string(), message };
+        let positive = |what: &str, value: f64| {
+            if value.is_finite() && value > 0.0 { Ok(()) } else { Err(invalid(format!("{what} must be positive, got {value}"))) }
+        };
+        if !position.is_finite() {
+            return Err(invalid(format!("position {position} is not finite")));
+        }
+        // parry3d's cylinder runs along its local y axis; ours along z.
+        let mut local_frame = Quat::IDENTITY;
+        let collider = match &shape {
+            PropShape::Ground => SharedShape::new(HalfSpace::new(Vec3::Z)),
+            PropShape::Box { half_extents } => {
+                for v in half_extents.to_array() {
+                    positive("every half-extent", v)?;
+                }
+                SharedShape::new(Cuboid::new(to_f32(*half_extents)))
+            }
+            PropShape::Cylinder { radius, height } => {
+                positive("radius", *radius)?;
+                positive("height", *height)?;
+                local_frame = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+                SharedShape::new(Cylinder::new(0.5 * *height as f32, *radius as f32))
+            }
+            PropShape::Sphere { radius } => {
+                positive("radius", *radius)?;
+                SharedShape::new(Ball::new(*radius as f32))
+            }
+            PropShape::Mesh { vertices, triangles } => {
+                if triangles.is_empty() {
+                    return Err(invalid("the mesh has no triangles".into()));
+                }
+                if let Some(t) = triangles.iter().find(|t| t.iter().any(|&i| i as usize >= vertices.len())) {
+                    return Err(invalid(format!("triangle {t:?} refers to a vertex past the {} given", vertices.len())));
+                }
+                let points = vertices.iter().map(|v| to_f32(*v)).collect();
+                // ORIENTED gives pseudo-normals, so that a point inside the closed mesh is
+                // known to be inside.
+                let mesh = TriMesh::with_flags(points, triangles.clone(), TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES)
+                    .map_err(|e| invalid(format!("not a usable triangle mesh: {e:?}")))?;
+                SharedShape::new(mesh)
+            }
+        };
+        let pose = Pose::from_parts(to_f32(position), rotation.as_quat() * local_frame);
+        Ok(Self { name: name.to_string(), shape, position, rotation, collider, pose })
+    }
+
+    /// Signed distance, closest surface point and outward normal at `x`. Only meaningful
+    /// near the surface (within a few contact thicknesses), which is where it is used.
+    pub fn surface_point(&self, x: DVec3) -> SurfacePoint {
+        let query = to_f32(x);
+        let projection = self.collider.project_point(&self.pose, query, true);
+        let (point, inside) = if projection.is_inside {
+            // A solid query returns the point itself when inside; ask for the boundary.
+            let hollow = self.collider.project_point(&self.pose, query, false);
+            (to_f64(hollow.point), true)
+        } else {
+            (to_f64(projection.point), false)
+        };
+        let offset = x - point;
+        let length = offset.length();
+        let distance = if inside { -length } else { length };
+        let normal = if length > 1e-9 {
+            offset / distance
+        } else {
+            // On the surface: take the normal from a point pushed slightly along the
+            // gradient of a nearby query.
+            self.normal_near(x)
+        };
+        SurfacePoint { distance, point, normal }
+    }
+
+    fn normal_near(&self, x: DVec3) -> DVec3 {
+        // Central differences of the distance field, step 0.1 mm.
+        let e = 1e-4;
+        let d = |p: DVec3| {
+            let projection = self.collider.project_point(&self.pose, to_f32(p), true);
+            let distance = (p - to_f64(projection.point)).length();
+            if projection.is_inside { -distance } else { distance }
+        };
+        let g = DVec3::new(
+            d(x + DVec3::X * e) - d(x - DVec3::X * e),
+            d(x + DVec3::Y * e) - d(x - DVec3::Y * e),
+            d(x + DVec3::Z * e) - d(x - DVec3::Z * e),
+        );
+        g.try_normalize().unwrap_or(DVec3::Z)
+    }
+
+    /// First point where the segment from `a` to `b` enters the prop, with the surface
+    /// normal there, or None. A segment starting inside reports no entry.
+    pub fn segment_entry(&self, a: DVec3, b: DVec3) -> Option<SurfacePoint> {
+        let d = b - a;
+        let length = d.length();
+        if length < 1e-12 {
+            return None;
+        }
+        let ray = Ray::new(to_f32(a), to_f32(d / length));
+        let hit = self.collider.cast_ray_and_get_normal(&self.pose, &ray, length as f32, false)?;
+        let point = a + d / length * hit.time_of_impact as f64;
+        let normal = to_f64(hit.normal).normalize();
+        // A hollow cast also reports exits; keep entries only.
+        (normal.dot(d) < 0.0).then_some(SurfacePoint { distance: 0.0, point, normal })
+    }
+
+    /// The prop's surface as triangles in world coordinates, for rendering and export.
+    /// The ground is a square of side `ground_extent` centred under its position.
+    pub fn surface_mesh(&self, ground_extent: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+        let (local, triangles): (Vec<Vec3>, Vec<[u32; 3]>) = match &self.shape {
+            PropShape::Ground => {
+                let s = 0.5 * ground_extent as f32;
+                (vec![Vec3::new(-s, -s, 0.0), Vec3::new(s, -s, 0.0), Vec3::new(s, s, 0.0), Vec3::new(-s, s, 0.0)], vec![[0, 1, 2], [0, 2, 3]])
+            }
+            PropShape::Box { half_extents } => Cuboid::new(to_f32(*half_extents)).to_trimesh(),
+            PropShape::Cylinder { radius, height } => Cylinder::new(0.5 * *height as f32, *radius as f32).to_trimesh(96),
+            PropShape::Sphere { radius } => Ball::new(*radius as f32).to_trimesh(48, 24),
+            PropShape::Mesh { vertices, triangles } => (vertices.iter().map(|v| to_f32(*v)).collect(), triangles.clone()),
+        };
+        let world = local.into_iter().map(|p| to_f64(self.pose * p)).collect();
+        (world, triangles)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cylinder_stands_on_z() {
+        let p = Prop::new("pedestal", PropShape::Cylinder { radius: 0.09, height: 0.2 }, DVec3::new(0.0, 0.0, -0.1), DQuat::IDENTITY).unwrap();
+        let top = p.surface_point(DVec3::new(0.0, 0.0, 0.01));
+        assert!((top.distance - 0.01).abs() < 1e-6, "{top:?}");
+        assert!((top.normal - DVec3::Z).length() < 1e-5);
+        let side = p.surface_point(DVec3::new(0.1, 0.0, -0.1));
+        assert!((side.distance - 0.01).abs() < 1e-6, "{side:?}");
+        let inside = p.surface_point(DVec3::new(0.0, 0.0, -0.003));
+        assert!((inside.distance + 0.003).abs() < 1e-6, "{inside:?}");
+        assert!((inside.normal - DVec3::Z).length() < 1e-5, "{inside:?}");
+        let entry = p.segment_entry(DVec3::new(0.0, 0.0, 0.5), DVec3::new(0.0, 0.0, -0.5)).unwrap();
+        assert!(entry.point.z.abs() < 1e-6 && entry.normal.z > 0.99, "{entry:?}");
+        assert!(p.segment_entry(DVec3::new(0.0, 0.0, -0.05), DVec3::new(0.0, 0.0, 0.5)).is_none());
+    }
+
+    #[test]
+    fn ground_and_box() {
+        let g = Prop::new("floor", PropShape::Ground, DVec3::new(0.0, 0.0, -1.0), DQuat::IDENTITY).unwrap();
+        let s = g.surface_point(DVec3::new(3.0, 2.0, -1.5));
+        assert!((s.distance + 0.5).abs() < 1e-6 && s.normal.z > 0.99, "{s:?}");
+        let b = Prop::new("table", PropShape::Box { half_extents: DVec3::new(0.5, 0.5, 0.01) }, DVec3::ZERO, DQuat::IDENTITY).unwrap();
+        let e = b.segment_entry(DVec3::new(0.2, 0.0, 1.0), DVec3::new(0.2, 0.0, -1.0)).unwrap();
+        assert!((e.point.z - 0.01).abs() < 1e-6);
+        assert!(Prop::new("bad", PropShape::Sphere { radius: -1.0 }, DVec3::ZERO, DQuat::IDENTITY).is_err());
+    }
+}
