@@ -1,6 +1,7 @@
 //! Scenes: a preset turned into a model, an initial state, a test rig and its measurements.
 //! One registry (`preset::SCENES`) feeds the command line, the tests and the viewer.
 
+pub mod drape;
 pub mod preset;
 pub mod props;
 pub mod rigs;
@@ -10,6 +11,7 @@ pub mod strip;
 pub use preset::{SceneConfig, SceneKind, load_scene};
 pub use run::{Metrics, RunOptions, run_scene};
 
+use crate::sim::contact::{ContactModel, ContactSettings};
 use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -51,38 +53,39 @@ impl Scene {
             damping: config.solver.damping,
         };
         let c = &config.cloth;
-        let h = config.mesh.edge_length;
         let warp = c.warp_angle_deg.to_radians();
-        // Strips clamped at one end carry a clamp band behind x = 0, a whole number of cells
-        // long, and the mesh is made at the exact column spacing so that a column of vertices
-        // lies on the clamp line.
-        let clamped = matches!(config.scene.kind, SceneKind::Cantilever | SceneKind::Arc);
-        let (clamp_band, spacing) = if clamped {
-            let cells = (c.length / h).round().max(1.0);
-            let spacing = c.length / cells;
-            let clamp_cells = (config.test.clamp_length.unwrap_or(2.0 * h) / spacing).round().max(2.0);
-            (clamp_cells * spacing, spacing)
-        } else {
-            (0.0, h)
-        };
-        // The arc also has a grip band beyond the free length.
-        let grip_band = if config.scene.kind == SceneKind::Arc { clamp_band } else { 0.0 };
-        let mut mesh = Mesh::rectangle(c.length + clamp_band + grip_band, c.width, spacing, config.mesh.pattern, config.scene.seed)
-            .map_err(ModelError::from)?;
-        for p in &mut mesh.rest {
-            p.x -= clamp_band;
-        }
+        let drape = config.scene.kind == SceneKind::Drape;
+        let (mesh, clamp_band) = if drape { (drape_mesh(&config)?, 0.0) } else { strip_mesh(&config)? };
         let mut model = Model::new(&mesh, &fabric, warp, options)?;
-        let mut x: Vec<DVec3> = mesh.rest.iter().map(|p| DVec3::new(p.x, p.y, 0.0)).collect();
+        let origin = DVec3::from_array(c.position);
+        let mut x: Vec<DVec3> = mesh.rest.iter().map(|p| origin + DVec3::new(p.x, p.y, 0.0)).collect();
         let rig = Rig::attach(&config, &mut model, &x, clamp_band)?;
         if let Some(amplitude) = config.test.perturbation {
-            // The paper's start: a random displacement along the normal, between 0 and the amplitude.
             let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(config.scene.seed);
-            for (i, p) in x.iter_mut().enumerate() {
-                if !model.fixed[i] {
-                    p.z += rng.random_range(0.0..=amplitude);
+            if drape {
+                perturb_smoothly(&mut x, &model, origin, amplitude, &mut rng);
+            } else {
+                // The paper's start: a random displacement along the normal, between 0 and
+                // the amplitude.
+                for (i, p) in x.iter_mut().enumerate() {
+                    if !model.fixed[i] {
+                        p.z += rng.random_range(0.0..=amplitude);
+                    }
                 }
             }
+        }
+        if !props.is_empty() || config.contact.self_collision {
+            let k = &config.contact;
+            let settings = ContactSettings {
+                thickness: k.thickness,
+                friction_static: k.friction_static,
+                friction_kinetic: k.friction_kinetic,
+                self_collision: k.self_collision,
+                self_thickness: k.self_thickness.unwrap_or(k.thickness.min(0.2 * model.mean_edge_length)),
+                stiffness: k.stiffness,
+                ..ContactSettings::default()
+            };
+            model.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
         }
         let mut integrator = Integrator::new(config.solver.integrator, config.solver.dt);
         integrator.newton = config.solver.newton;
@@ -103,5 +106,64 @@ impl Scene {
     /// The rig's measurements as JSON.
     pub fn measures(&self) -> serde_json::Value {
         self.rig.finish(&self.model, &self.state)
+    }
+}
+
+/// A rectangular strip for the laboratory tests. Strips clamped at one end carry a clamp
+/// band behind x = 0, a whole number of cells long, and the mesh is made at the exact
+/// column spacing so that a column of vertices lies on the clamp line. Returns the mesh and
+/// the clamp band's length.
+fn strip_mesh(config: &SceneConfig) -> Result<(Mesh, f64), SceneError> {
+    let (c, h) = (&config.cloth, config.mesh.edge_length);
+    let clamped = matches!(config.scene.kind, SceneKind::Cantilever | SceneKind::Arc);
+    let (clamp_band, spacing) = if clamped {
+        let cells = (c.length / h).round().max(1.0);
+        let spacing = c.length / cells;
+        let clamp_cells = (config.test.clamp_length.unwrap_or(2.0 * h) / spacing).round().max(2.0);
+        (clamp_cells * spacing, spacing)
+    } else {
+        (0.0, h)
+    };
+    // The arc also has a grip band beyond the free length.
+    let grip_band = if config.scene.kind == SceneKind::Arc { clamp_band } else { 0.0 };
+    let mut mesh = Mesh::rectangle(c.length + clamp_band + grip_band, c.width, spacing, config.mesh.pattern, config.scene.seed)
+        .map_err(ModelError::from)?;
+    for p in &mut mesh.rest {
+        p.x -= clamp_band;
+    }
+    Ok((mesh, clamp_band))
+}
+
+/// A drape specimen centred on the origin: a disc (`cloth.diameter`) or a rectangle.
+fn drape_mesh(config: &SceneConfig) -> Result<Mesh, SceneError> {
+    let (c, h) = (&config.cloth, config.mesh.edge_length);
+    if c.diameter > 0.0 {
+        return Ok(Mesh::disc(c.diameter, h).map_err(ModelError::from)?);
+    }
+    let mut mesh = Mesh::rectangle(c.length, c.width, h, config.mesh.pattern, config.scene.seed).map_err(ModelError::from)?;
+    for p in &mut mesh.rest {
+        *p -= glam::DVec2::new(c.length, c.width) / 2.0;
+    }
+    Ok(mesh)
+}
+
+/// Drape scenes start from a flat cloth lifted by a smooth random ripple: a sum of angular
+/// modes k = 2..12 with random phases and amplitudes, growing with the square of the
+/// distance from the centre. Unlike noise per vertex it is the same surface whatever the
+/// mesh, so runs at different resolutions start alike, and it breaks the symmetry that
+/// would otherwise leave a perfect disc undecided where to fold.
+fn perturb_smoothly(x: &mut [DVec3], model: &Model, origin: DVec3, amplitude: f64, rng: &mut impl Rng) {
+    let modes: Vec<(f64, f64, f64)> =
+        (2..=12).map(|k| (k as f64, rng.random_range(0.0..1.0), rng.random_range(0.0..std::f64::consts::TAU))).collect();
+    let norm: f64 = modes.iter().map(|m| m.1).sum();
+    let reach = model.rest.iter().map(|p| p.length()).fold(0.0, f64::max).max(1e-9);
+    for (i, p) in x.iter_mut().enumerate() {
+        if model.fixed[i] {
+            continue;
+        }
+        let r = (*p - origin).truncate();
+        let angle = r.y.atan2(r.x);
+        let ripple: f64 = modes.iter().map(|(k, a, phase)| a * (k * angle + phase).cos()).sum::<f64>() / norm;
+        p.z += amplitude * (r.length() / reach).powi(2) * ripple;
     }
 }

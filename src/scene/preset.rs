@@ -25,7 +25,8 @@ macro_rules! bundled {
 
 /// Bundled scenes; their file stems are the names users type.
 pub const SCENES: &[Bundled] = bundled!("";
-    "tensile-warp", "tensile-weft", "tensile-bias", "cantilever", "arc", "euler-buckling", "shear-buckling");
+    "tensile-warp", "tensile-weft", "tensile-bias", "cantilever", "arc", "euler-buckling", "shear-buckling",
+    "cusick-drape", "cusick-drape-30", "tablecloth");
 
 /// Bundled fabrics.
 pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk");
@@ -61,6 +62,9 @@ pub enum SceneKind {
     EulerBuckling,
     /// One edge clamped, the opposite edge moved along the warp (paper Figs. 9–10).
     ShearBuckling,
+    /// A cloth falling or resting on props until it settles: the Cusick drape test
+    /// (paper Fig. 6, BS 5058), a tablecloth.
+    Drape,
 }
 
 /// A complete scene description, after the fabric file and overrides are merged.
@@ -259,6 +263,9 @@ pub struct ClothSection {
     /// Angle of the warp from the sample's x axis, degrees.
     #[serde(default)]
     pub warp_angle_deg: f64,
+    /// Drape: where the cloth's centre starts, [x, y, z] m (it starts flat and level).
+    #[serde(default)]
+    pub position: [f64; 3],
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -317,6 +324,13 @@ pub struct TestSection {
     pub clamp_length: Option<f64>,
     /// Shear buckling: how the moving grip travels (default `trellis`).
     pub shear_kinematics: Option<ShearKinematics>,
+    /// Drape: radius of the clamped centre of the specimen, m (Cusick: the 18 cm discs
+    /// that sandwich it; absent: nothing is clamped).
+    pub clamp_radius: Option<f64>,
+    /// Drape: diameter of the support disc for the drape coefficient, m.
+    pub support_diameter: Option<f64>,
+    /// Drape: size of a rectangular support (a table top), [x, y] m, for the drape coefficient.
+    pub support_size: Option<[f64; 2]>,
 }
 
 /// How the shear rig's moving grip travels.
@@ -479,8 +493,29 @@ fn check_scene(c: &SceneConfig) -> Result<(), String> {
             need("test.curvature", c.test.curvature)?;
         }
         SceneKind::Cantilever => {}
+        SceneKind::Drape => {
+            if c.props.is_empty() {
+                return Err("a drape scene needs at least one [[props]] table to drape over".into());
+            }
+            if c.test.support_diameter.is_none() && c.test.support_size.is_none() {
+                return Err("a drape scene needs test.support_diameter (a pedestal) or test.support_size (a table top), m".into());
+            }
+            if let Some(r) = c.test.clamp_radius {
+                positive("test.clamp_radius", r)?;
+            }
+        }
     }
-    // Every laboratory scene so far is a rectangular strip.
+    if c.contact.friction_kinetic > c.contact.friction_static || c.contact.friction_kinetic < 0.0 {
+        return Err(format!(
+            "contact.friction_kinetic = {} must lie between 0 and contact.friction_static = {}",
+            c.contact.friction_kinetic, c.contact.friction_static
+        ));
+    }
+    positive("contact.thickness", c.contact.thickness)?;
+    if c.scene.kind == SceneKind::Drape && c.cloth.diameter > 0.0 {
+        return positive("cloth.diameter", c.cloth.diameter);
+    }
+    // Every other scene is a rectangular cloth.
     positive("cloth.length", c.cloth.length)?;
     positive("cloth.width", c.cloth.width)?;
     Ok(())

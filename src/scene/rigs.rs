@@ -2,7 +2,7 @@
 
 use super::strip::{Columns, count_half_waves, fit_circle_radius, group_force, vertices_where};
 use super::preset::ShearKinematics;
-use super::{SceneConfig, SceneError, SceneKind};
+use super::{SceneConfig, SceneError, SceneKind, drape};
 use crate::sim::{Model, Motion, State};
 use glam::{DVec2, DVec3};
 use serde_json::json;
@@ -16,6 +16,32 @@ pub enum Rig {
     Arc(Arc),
     Euler(Euler),
     Shear(Shear),
+    Drape(Drape),
+}
+
+pub struct Drape {
+    /// Centre of the support, where the outline's radius is measured from.
+    centre: DVec2,
+    /// Area of the support (pedestal disc or table top), m².
+    support_area: f64,
+    /// Area of the flat specimen (its mesh), m².
+    specimen_area: f64,
+    /// Smallest prominence of a fold, m.
+    prominence: f64,
+    /// (t, drape coefficient, nodes) while the cloth drapes.
+    history: Vec<(f64, f64, usize)>,
+}
+
+/// Outline smoothing for node counting: about 6°, less than half the spacing of 10 nodes.
+const NODE_SMOOTHING: f64 = 0.1;
+
+impl Drape {
+    fn measure(&self, model: &Model, state: &State, resolution: usize) -> (drape::Shadow, f64, usize) {
+        let shadow = drape::shadow(&state.x, &model.triangles, self.centre, resolution);
+        let dc = drape::drape_coefficient(shadow.area, self.specimen_area, self.support_area);
+        let nodes = drape::count_nodes(&shadow.outline, NODE_SMOOTHING, self.prominence);
+        (shadow, dc, nodes)
+    }
 }
 
 pub struct Tensile {
@@ -72,6 +98,25 @@ impl Rig {
             }
         };
         Ok(match config.scene.kind {
+            SceneKind::Drape => {
+                let centre = DVec2::new(config.cloth.position[0], config.cloth.position[1]);
+                if let Some(radius) = t.clamp_radius {
+                    let rigid: Vec<bool> = rest.iter().map(|p| p.length() <= radius * (1.0 + 1e-9)).collect();
+                    for (v, _) in rigid.iter().enumerate().filter(|(_, r)| **r) {
+                        model.pin(v as u32, x[v]);
+                    }
+                    model.set_clamped_region(&rigid)?;
+                }
+                let support_area = match (t.support_diameter, t.support_size) {
+                    (Some(d), _) => std::f64::consts::PI * d * d / 4.0,
+                    (None, Some([a, b])) => a * b,
+                    (None, None) => unreachable!("checked when loading"),
+                };
+                let specimen_area: f64 = model.vertex_area.iter().sum();
+                let reach = |area: f64| (area / std::f64::consts::PI).sqrt();
+                let prominence = 0.03 * (reach(specimen_area) - reach(support_area)).max(h);
+                Rig::Drape(Drape { centre, support_area, specimen_area, prominence, history: Vec::new() })
+            }
             SceneKind::Tensile => {
                 let fixed = vertices_where(&rest, |p| p.x < ON_EDGE);
                 let moving = vertices_where(&rest, |p| p.x > length - ON_EDGE);
@@ -164,6 +209,10 @@ impl Rig {
                 let (b, t) = r.mid_edges;
                 let lateral = (state.x[t as usize].y - state.x[b as usize].y) / r.width - 1.0;
                 r.samples.push([clamp_strain, extensometer, lateral, stress]);
+            }
+            Rig::Drape(r) => {
+                let (_, dc, nodes) = r.measure(model, state, 256);
+                r.history.push((state.time, dc, nodes));
             }
             Rig::Euler(r) => {
                 let mut f = vec![DVec3::ZERO; state.x.len()];
@@ -272,6 +321,27 @@ impl Rig {
                 })
             }
             Rig::Shear(r) => shear_measures(r, model, state),
+            Rig::Drape(r) => {
+                let (shadow, dc, nodes) = r.measure(model, state, 1024);
+                json!({
+                    "drape_coefficient": dc,
+                    "nodes": nodes,
+                    "shadow_area": shadow.area,
+                    "specimen_area": r.specimen_area,
+                    "support_area": r.support_area,
+                    "outline_radius_min": shadow.outline.iter().map(|o| o.1).fold(f64::INFINITY, f64::min),
+                    "outline_radius_max": shadow.outline.iter().map(|o| o.1).fold(0.0, f64::max),
+                    "history": r.history.iter().step_by((r.history.len() / 100).max(1)).map(|h| json!([h.0, h.1, h.2])).collect::<Vec<_>>(),
+                })
+            }
+        }
+    }
+
+    /// The drape's shadow outline, (angle rad, radius m); None for other rigs.
+    pub fn outline(&self, model: &Model, state: &State) -> Option<Vec<(f64, f64)>> {
+        match self {
+            Rig::Drape(r) => Some(r.measure(model, state, 1024).0.outline),
+            _ => None,
         }
     }
 }

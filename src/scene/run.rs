@@ -32,6 +32,17 @@ pub struct Metrics {
     /// Why the run stopped early, if it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// Deepest any vertex went inside a prop over the run, m (scenes with contact).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_penetration: Option<f64>,
+    /// Edge–triangle crossings of the cloth with itself in the final state (scenes with
+    /// contact).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub self_intersections: Option<usize>,
+    /// Steps solved again for a contact the prediction missed, and crossings stopped by
+    /// the self-collision fail-safe.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_events: Option<serde_json::Value>,
     pub newton_iterations: u64,
     pub cg_iterations: u64,
     pub measures: serde_json::Value,
@@ -108,6 +119,16 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         settled: settle_speed.map(|_| settle_time.is_some()),
         settle_time,
         error: error.as_ref().map(|e| e.to_string()),
+        max_penetration: scene.model.contact.as_ref().map(|_| scene.integrator.contact_stats.max_penetration),
+        self_intersections: scene
+            .model
+            .contact
+            .as_ref()
+            .map(|_| crate::sim::contact::count_self_intersections(&scene.state.x, &scene.model.triangles, &scene.model.edges)),
+        contact_events: scene.model.contact.as_ref().map(|_| {
+            let s = scene.integrator.contact_stats;
+            serde_json::json!({ "resolves": s.resolves, "impacts": s.impacts })
+        }),
         newton_iterations: newton,
         cg_iterations: cg,
         measures: scene.measures(),

@@ -12,6 +12,7 @@
 //! A step that produces a non-finite or exploding state is rejected: the state is left as
 //! it was and the error names the integrator, Δt and time.
 
+use crate::sim::contact::{ContactModel, ContactStats, StepContacts};
 use crate::sim::model::Model;
 use crate::sim::sparse::{SystemMatrix, pcg};
 use glam::DVec3;
@@ -136,11 +137,13 @@ pub struct Integrator {
     /// A state whose largest edge stretch exceeds this ratio has blown up.
     pub max_stretch: f64,
     forces: Vec<DVec3>,
+    /// What contact did so far.
+    pub contact_stats: ContactStats,
 }
 
 impl Integrator {
     pub fn new(kind: IntegratorKind, dt: f64) -> Self {
-        Self { kind, dt, newton: NewtonSettings::default(), max_stretch: 4.0, forces: Vec::new() }
+        Self { kind, dt, newton: NewtonSettings::default(), max_stretch: 4.0, forces: Vec::new(), contact_stats: ContactStats::default() }
     }
 
     /// Advances `state` by one step. On error `state` is unchanged.
@@ -192,6 +195,7 @@ impl Integrator {
         model.forces(&s.x, &mut self.forces);
         let damping = 1.0 / (1.0 + model.options.damping * dt);
         let t_next = s.time + dt;
+        let start = s.x.clone();
         for i in 0..s.x.len() {
             if model.fixed[i] {
                 let target = model.prescribed_position(i, t_next);
@@ -202,7 +206,21 @@ impl Integrator {
                 s.x[i] += dt * s.v[i];
             }
         }
+        if let Some(contact) = &model.contact {
+            contact.project_explicit(&start, &mut s.x, &mut s.v, &model.fixed);
+            self.finish_contact(model, contact, &start, s);
+        }
         s.previous = None;
+    }
+
+    /// The end of every step with contact: the self-crossing fail-safe and the penetration
+    /// record.
+    fn finish_contact(&mut self, model: &Model, contact: &ContactModel, start: &[DVec3], s: &mut State) {
+        if contact.settings.self_collision {
+            self.contact_stats.impacts += contact.stop_self_crossings(start, &mut s.x, &mut s.v, &model.mass, &model.triangles, &model.edges);
+        }
+        let depth = contact.penetration(&s.x, &model.fixed);
+        self.contact_stats.max_penetration = self.contact_stats.max_penetration.max(depth);
     }
 
     fn implicit(&mut self, model: &Model, s: &mut State, bdf2: bool) -> StepReport {
@@ -220,8 +238,6 @@ impl Integrator {
             }
             _ => (dt, s.x.clone(), (0..n).map(|i| s.x[i] + dt * s.v[i]).collect()),
         };
-        let zeta = model.options.damping;
-        let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
         let t_next = s.time + dt;
         let mut y = inertial.clone();
         for i in 0..n {
@@ -229,6 +245,47 @@ impl Integrator {
                 y[i] = model.prescribed_position(i, t_next);
             }
         }
+        let step = ImplicitStep { model, h, anchor: &anchor, inertial: &inertial };
+        let mut report = StepReport::default();
+        match &model.contact {
+            None => self.newton(&step, None, &mut y, &mut report),
+            Some(contact) => {
+                // The prediction includes gravity's pull over the step, so that contacts a
+                // falling cloth is about to make are there from the first iteration.
+                let predicted: Vec<DVec3> = (0..n).map(|i| inertial[i] + h * h * model.options.gravity).collect();
+                let mut contacts = contact.begin_step(&s.x, &predicted, &model.fixed, &model.mass, &model.triangles, h);
+                // Solve; a path that enters a prop without a plane adds one and solves again.
+                for pass in 0..4 {
+                    self.newton(&step, Some(&contacts), &mut y, &mut report);
+                    if contact.add_missed(&mut contacts, &s.x, &y, &model.fixed, &model.mass, h) == 0 {
+                        break;
+                    }
+                    self.contact_stats.resolves += 1;
+                    if pass == 3 {
+                        report.newton_unconverged = true;
+                    }
+                }
+            }
+        }
+        let previous = (s.x.clone(), s.v.clone());
+        let start = s.x.clone();
+        for i in 0..n {
+            s.v[i] = (y[i] - anchor[i]) / h;
+        }
+        s.x = y;
+        if let Some(contact) = &model.contact {
+            self.finish_contact(model, contact, &start, s);
+        }
+        s.previous = Some(previous);
+        report
+    }
+
+    /// Newton's method on the incremental potential Φ (plus contact), from `y` in place.
+    fn newton(&mut self, step: &ImplicitStep, contacts: Option<&StepContacts>, y: &mut Vec<DVec3>, report: &mut StepReport) {
+        let ImplicitStep { model, h, anchor, inertial } = *step;
+        let n = y.len();
+        let zeta = model.options.damping;
+        let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
         let objective = |y: &[DVec3]| -> f64 {
             let mut inertia = 0.0;
             for i in 0..n {
@@ -238,19 +295,21 @@ impl Integrator {
                         + zeta * m / (2.0 * h) * (y[i] - anchor[i]).length_squared();
                 }
             }
-            inertia + model.potential_energy(y)
+            inertia + model.potential_energy(y) + contacts.map_or(0.0, |c| c.energy(y, anchor))
         };
         let mut stiffness = model.stiffness_matrix();
         let mut gradient = vec![DVec3::ZERO; n];
         let mut direction = vec![DVec3::ZERO; n];
         let mut trial = y.clone();
         let tolerance = self.newton.tolerance * model.mean_edge_length;
-        let all_free = !model.fixed.iter().any(|&f| f);
-        let mut report = StepReport { newton_unconverged: true, ..Default::default() };
+        // With nothing fixed and nothing touched, the elastic forces are internal: momentum
+        // is conserved, and the Newton direction is corrected to keep it so.
+        let all_free = !model.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
+        report.newton_unconverged = true;
         let mut phi_current: Option<f64> = None;
         for _ in 0..self.newton.max_iterations {
             self.forces.resize(n, DVec3::ZERO);
-            model.forces(&y, &mut self.forces);
+            model.forces(y, &mut self.forces);
             let forces = &self.forces;
             for i in 0..n {
                 gradient[i] = if model.fixed[i] {
@@ -259,8 +318,17 @@ impl Integrator {
                     model.mass[i] / (h * h) * (y[i] - inertial[i]) + zeta * model.mass[i] / h * (y[i] - anchor[i]) - forces[i]
                 };
             }
-            model.assemble_membrane_stiffness(&y, &mut stiffness);
-            let bending = model.bending_newton_matrix(&y);
+            model.assemble_membrane_stiffness(y, &mut stiffness);
+            if let Some(c) = contacts {
+                c.add_gradient(y, anchor, &mut gradient, &model.fixed);
+                for (g, &f) in gradient.iter_mut().zip(&model.fixed) {
+                    if f {
+                        *g = DVec3::ZERO;
+                    }
+                }
+                c.add_hessian(y, anchor, &mut stiffness);
+            }
+            let bending = model.bending_newton_matrix(y);
             let system = SystemMatrix {
                 mass_diagonal: &mass_diagonal,
                 stiffness: &stiffness,
@@ -294,7 +362,7 @@ impl Integrator {
             }
             let slope: f64 = gradient.iter().zip(&direction).map(|(g, d)| g.dot(*d)).sum();
             // Φ at the current iterate is the previous iteration's accepted trial value.
-            let phi0 = *phi_current.get_or_insert_with(|| objective(&y));
+            let phi0 = *phi_current.get_or_insert_with(|| objective(y));
             let mut alpha = 1.0;
             let mut accepted = false;
             let mut phi = phi0;
@@ -319,18 +387,21 @@ impl Integrator {
                     break;
                 }
             }
-            std::mem::swap(&mut y, &mut trial);
+            std::mem::swap(y, &mut trial);
             if step_size < tolerance {
                 report.newton_unconverged = false;
                 break;
             }
         }
-        let previous = (s.x.clone(), s.v.clone());
-        for i in 0..n {
-            s.v[i] = (y[i] - anchor[i]) / h;
-        }
-        s.x = y;
-        s.previous = Some(previous);
-        report
     }
+}
+
+/// What one implicit step minimises over: Φ's inertial target x̃, the anchor x̂ of the
+/// step's velocity, and the effective step h.
+#[derive(Clone, Copy)]
+struct ImplicitStep<'a> {
+    model: &'a Model,
+    h: f64,
+    anchor: &'a [DVec3],
+    inertial: &'a [DVec3],
 }

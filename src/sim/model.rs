@@ -5,6 +5,7 @@
 //! sees the same conservative model. Everything that a scene switches off (membrane,
 //! bending, gravity) is absent from the model, not multiplied by zero.
 
+use crate::sim::contact::ContactModel;
 use crate::sim::curve::PiecewiseLinear;
 use crate::sim::material::{BendingStiffness, Fabric, FabricError, MembraneLaw};
 use crate::sim::mesh::{Mesh, MeshError};
@@ -163,6 +164,8 @@ pub struct Model {
     motions: Vec<Motion>,
     /// Undirected edges (a < b), for strain checks and drawing.
     pub edges: Vec<[u32; 2]>,
+    /// Props and contact settings; None where the cloth touches nothing.
+    pub contact: Option<ContactModel>,
 }
 
 /// Rotates a sample-plane vector into the warp frame (x along the warp).
@@ -231,6 +234,7 @@ impl Model {
             driver: vec![0; n],
             motions: vec![Motion::STILL],
             edges: edge_set,
+            contact: None,
         };
         if options.bending {
             model.build_bending(&vec![false; n])?;

@@ -1,4 +1,640 @@
 //! Contact: cloth against rigid props and cloth against itself.
+//!
+//! How contact keeps the integrators' stability:
+//! - Implicit integrators (implicit Euler, BDF2) take contact *inside* the minimisation
+//!   of the incremental potential. At the start of a step every vertex near a prop, or
+//!   whose predicted path x → x + h·v enters one, gets a contact plane (the prop's closest
+//!   point and normal, or the entry point of the path). The plane adds the energy
+//!   ½k·max(0, τ − n·(y − p))², τ the contact thickness, with k = c·m/h² scaled by the
+//!   vertex mass so that it stiffens the Newton system no more than inertia does (c = 100:
+//!   the cloth sinks g·h²/c into its thickness layer under its own weight). Coulomb
+//!   friction enters as IPC's lagged dissipative potential: the normal force λ and the
+//!   plane are frozen over the step, the tangential slip u = T(y − x̂) pays λ·F(|u|) with
+//!   F' = μ_s·|u|/ε below the slip threshold ε = v_ε·h (sticking) and decaying from μ_s to
+//!   μ_k beyond it (sliding). Because both are energies, the line search, the energy
+//!   checks and the unconditional stability of the implicit step are kept. After the
+//!   solve, any path that still enters a prop (a new contact the prediction missed) adds
+//!   its plane and the step is solved again: no vertex tunnels through a thin prop at any
+//!   step size.
+//! - The explicit integrator takes contact at the velocity level after its update: a
+//!   vertex that ends inside the thickness layer, or whose path entered the prop, is put
+//!   back on the layer, loses its inward normal velocity, and its tangential velocity is
+//!   reduced by a Coulomb impulse (stopped if μ_s·|Δv_n| suffices). This adds no stiffness,
+//!   so the explicit stability limit is the cloth's own.
+//! - Cloth–cloth: vertex–triangle pairs closer than the layer thickness δ at the start of
+//!   a step (found with a spatial hash) get the repulsion ½k·max(0, δ − d)², d the
+//!   point–triangle distance, in the implicit solve. Whatever the solve did, a continuous
+//!   collision test of every vertex–triangle and edge–edge pair over the step follows; the
+//!   vertices of a pair that would cross are held at their start positions and share
+//!   their mean velocity (an inelastic impact zone), repeated until no pair crosses. The
+//!   start of the step is free of crossings, so this always ends with none.
+
+pub mod geometry;
 pub mod props;
 
 pub use props::{Prop, PropError, PropShape, SurfacePoint};
+
+use crate::sim::sparse::BlockCsr;
+use geometry::{SpatialHash, closest_point_triangle, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
+use glam::{DMat3, DVec3};
+
+/// Contact parameters, SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactSettings {
+    /// Distance the cloth keeps from props, m.
+    pub thickness: f64,
+    /// Coulomb coefficient while sticking.
+    pub friction_static: f64,
+    /// Coulomb coefficient while sliding.
+    pub friction_kinetic: f64,
+    /// Cloth–cloth contact on or off.
+    pub self_collision: bool,
+    /// Distance kept between cloth layers, m.
+    pub self_thickness: f64,
+    /// Penalty stiffness as a multiple of m/h² (implicit integrators).
+    pub stiffness: f64,
+    /// Tangential speed below which friction sticks, m/s.
+    pub slip_speed: f64,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
+            thickness: 0.002,
+            friction_static: 0.5,
+            friction_kinetic: 0.4,
+            self_collision: false,
+            self_thickness: 0.001,
+            stiffness: 100.0,
+            slip_speed: 1e-3,
+        }
+    }
+}
+
+impl ContactSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = |key: &str, v: f64| if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("contact.{key} must be positive, got {v}")) };
+        positive("thickness", self.thickness)?;
+        positive("self_thickness", self.self_thickness)?;
+        positive("stiffness", self.stiffness)?;
+        positive("slip_speed", self.slip_speed)?;
+        if !(self.friction_static >= 0.0 && self.friction_kinetic >= 0.0 && self.friction_static.is_finite()) {
+            return Err("contact.friction_static and contact.friction_kinetic must be zero or positive".into());
+        }
+        if self.friction_kinetic > self.friction_static {
+            return Err(format!(
+                "contact.friction_kinetic = {} exceeds contact.friction_static = {}: sliding friction is at most sticking friction",
+                self.friction_kinetic, self.friction_static
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The props and settings of a scene: the fixed part of contact.
+#[derive(Debug, Clone)]
+pub struct ContactModel {
+    pub props: Vec<Prop>,
+    pub settings: ContactSettings,
+    /// World bounding box of each prop (None: unbounded, the ground).
+    bounds: Vec<Option<(DVec3, DVec3)>>,
+}
+
+/// A vertex held outside a prop by a plane over one step.
+#[derive(Debug, Clone, Copy)]
+struct PlaneContact {
+    vertex: u32,
+    prop: u32,
+    point: DVec3,
+    normal: DVec3,
+    /// Penalty stiffness, N/m.
+    stiffness: f64,
+    /// Normal force at the start of the step (lagged for friction), N.
+    normal_force: f64,
+}
+
+/// A vertex kept away from a triangle of the cloth over one step.
+#[derive(Debug, Clone, Copy)]
+struct SelfPair {
+    vertex: u32,
+    triangle: [u32; 3],
+    stiffness: f64,
+}
+
+/// Counters of what contact did, accumulated over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ContactStats {
+    /// Deepest any vertex has been inside a prop at the end of a step, m.
+    pub max_penetration: f64,
+    /// Steps solved again because a path entered a prop the prediction missed.
+    pub resolves: u64,
+    /// Vertex–triangle or edge–edge crossings stopped by impact zones.
+    pub impacts: u64,
+}
+
+/// The contacts active over one step.
+pub struct StepContacts {
+    planes: Vec<PlaneContact>,
+    pairs: Vec<SelfPair>,
+    mu_static: f64,
+    mu_kinetic: f64,
+    thickness: f64,
+    self_thickness: f64,
+    /// Slip threshold over the step, m.
+    slip: f64,
+}
+
+impl ContactModel {
+    pub fn new(props: Vec<Prop>, settings: ContactSettings) -> Result<Self, String> {
+        settings.validate()?;
+        let bounds = props
+            .iter()
+            .map(|p| {
+                if matches!(p.shape, PropShape::Ground) {
+                    return None;
+                }
+                let (vertices, _) = p.surface_mesh(0.0);
+                let lo = vertices.iter().fold(DVec3::INFINITY, |a, v| a.min(*v));
+                let hi = vertices.iter().fold(DVec3::NEG_INFINITY, |a, v| a.max(*v));
+                Some((lo, hi))
+            })
+            .collect();
+        Ok(Self { props, settings, bounds })
+    }
+
+    fn near_bounds(&self, prop: usize, a: DVec3, b: DVec3, margin: f64) -> bool {
+        match self.bounds[prop] {
+            None => true,
+            Some((lo, hi)) => {
+                let (pl, ph) = (a.min(b) - DVec3::splat(margin), a.max(b) + DVec3::splat(margin));
+                pl.cmple(hi).all() && ph.cmpge(lo).all()
+            }
+        }
+    }
+
+    /// The contacts for a step from `start` (positions x_n) towards `predicted` (x_n + h v_n
+    /// or the BDF2 equivalent), with time step `h` and vertex masses.
+    pub fn begin_step(&self, start: &[DVec3], predicted: &[DVec3], fixed: &[bool], mass: &[f64], triangles: &[[u32; 3]], h: f64) -> StepContacts {
+        let s = &self.settings;
+        let mut contacts = StepContacts {
+            planes: Vec::new(),
+            pairs: Vec::new(),
+            mu_static: s.friction_static,
+            mu_kinetic: s.friction_kinetic,
+            thickness: s.thickness,
+            self_thickness: s.self_thickness,
+            slip: s.slip_speed * h,
+        };
+        for v in 0..start.len() {
+            if !fixed[v] {
+                self.add_planes(v, start[v], predicted[v], mass[v], h, &mut contacts.planes, false);
+            }
+        }
+        if s.self_collision {
+            contacts.pairs = self.self_pairs(start, predicted, fixed, mass, triangles, h);
+        }
+        contacts
+    }
+
+    /// Adds vertex `v`'s planes: props within reach of its path, or entered by it. With
+    /// `only_missing`, only props the vertex has no plane with yet. Returns how many.
+    #[allow(clippy::too_many_arguments)]
+    fn add_planes(&self, v: usize, a: DVec3, b: DVec3, m: f64, h: f64, planes: &mut Vec<PlaneContact>, only_missing: bool) -> usize {
+        let s = &self.settings;
+        let reach = s.thickness + (b - a).length();
+        let mut added = 0;
+        for (p, prop) in self.props.iter().enumerate() {
+            if !self.near_bounds(p, a, b, reach + s.thickness) {
+                continue;
+            }
+            if only_missing && planes.iter().any(|c| c.vertex == v as u32 && c.prop == p as u32) {
+                continue;
+            }
+            let stiffness = s.stiffness * m / (h * h);
+            let near = prop.surface_point(a);
+            let plane = if near.distance < reach + s.thickness {
+                Some(near)
+            } else {
+                prop.segment_entry(a, b)
+            };
+            if let Some(sp) = plane {
+                // The lagged normal force: what the penalty pushes with at the step's start.
+                let normal_force = stiffness * (s.thickness - near.distance).max(0.0);
+                planes.push(PlaneContact { vertex: v as u32, prop: p as u32, point: sp.point, normal: sp.normal, stiffness, normal_force });
+                added += 1;
+            }
+        }
+        added
+    }
+
+    /// After a solve from `start` to `end`: adds planes for paths that enter a prop without
+    /// one. Returns how many were added (zero: the step stands).
+    pub fn add_missed(&self, contacts: &mut StepContacts, start: &[DVec3], end: &[DVec3], fixed: &[bool], mass: &[f64], h: f64) -> usize {
+        let mut added = 0;
+        for v in 0..start.len() {
+            if fixed[v] {
+                continue;
+            }
+            for (p, prop) in self.props.iter().enumerate() {
+                if !self.near_bounds(p, start[v], end[v], self.settings.thickness) {
+                    continue;
+                }
+                if contacts.planes.iter().any(|c| c.vertex == v as u32 && c.prop == p as u32) {
+                    continue;
+                }
+                let inside_layer = prop.surface_point(end[v]).distance < 0.5 * self.settings.thickness;
+                if inside_layer || prop.segment_entry(start[v], end[v]).is_some() {
+                    added += self.add_planes(v, start[v], end[v], mass[v], h, &mut contacts.planes, true);
+                }
+            }
+        }
+        added
+    }
+
+    /// Deepest penetration of any vertex into any prop, m (zero when all are outside).
+    pub fn penetration(&self, x: &[DVec3], fixed: &[bool]) -> f64 {
+        let mut deepest = 0.0f64;
+        for (v, p) in x.iter().enumerate() {
+            if fixed[v] {
+                continue;
+            }
+            for (i, prop) in self.props.iter().enumerate() {
+                if self.near_bounds(i, *p, *p, self.settings.thickness) {
+                    deepest = deepest.max(-prop.surface_point(*p).distance);
+                }
+            }
+        }
+        deepest
+    }
+
+    /// Velocity-level contact for explicit integrators: positions `x` and velocities `v`
+    /// after an unconstrained update from `start`.
+    pub fn project_explicit(&self, start: &[DVec3], x: &mut [DVec3], v: &mut [DVec3], fixed: &[bool]) {
+        let s = &self.settings;
+        for i in 0..x.len() {
+            if fixed[i] {
+                continue;
+            }
+            for (p, prop) in self.props.iter().enumerate() {
+                if !self.near_bounds(p, start[i], x[i], 2.0 * s.thickness) {
+                    continue;
+                }
+                let near = prop.surface_point(x[i]);
+                let (point, normal) = if let Some(entry) = prop.segment_entry(start[i], x[i]) {
+                    (entry.point, entry.normal)
+                } else if near.distance < s.thickness {
+                    (near.point, near.normal)
+                } else {
+                    continue;
+                };
+                let depth = s.thickness - normal.dot(x[i] - point);
+                if depth <= 0.0 {
+                    continue;
+                }
+                x[i] += depth * normal;
+                let vn = v[i].dot(normal);
+                if vn < 0.0 {
+                    let dv = -vn;
+                    v[i] += dv * normal;
+                    let vt = v[i] - v[i].dot(normal) * normal;
+                    let speed = vt.length();
+                    if speed <= s.friction_static * dv {
+                        v[i] -= vt;
+                    } else {
+                        v[i] -= vt * (s.friction_kinetic * dv / speed);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Vertex–triangle pairs within reach over the step.
+    fn self_pairs(&self, start: &[DVec3], predicted: &[DVec3], fixed: &[bool], mass: &[f64], triangles: &[[u32; 3]], h: f64) -> Vec<SelfPair> {
+        let delta = self.settings.self_thickness;
+        let motion = |v: usize| (predicted[v] - start[v]).length();
+        let cell = mean_edge(start, triangles).max(2.0 * delta);
+        let mut hash = SpatialHash::new(cell);
+        for v in 0..start.len() {
+            let (lo, hi) = (start[v].min(predicted[v]), start[v].max(predicted[v]));
+            hash.insert_box(v as u32, lo, hi);
+        }
+        let mut pairs = Vec::new();
+        let mut seen = Vec::new();
+        for t in triangles {
+            let corners = t.map(|i| i as usize);
+            let lo = corners.iter().fold(DVec3::INFINITY, |a, &i| a.min(start[i]).min(predicted[i])) - DVec3::splat(delta);
+            let hi = corners.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(start[i]).max(predicted[i])) + DVec3::splat(delta);
+            let tri_motion = corners.iter().map(|&i| motion(i)).fold(0.0, f64::max);
+            seen.clear();
+            hash.query_box(lo, hi, |v| {
+                if !t.contains(&v) && !seen.contains(&v) {
+                    seen.push(v);
+                }
+            });
+            for &v in &seen {
+                let vi = v as usize;
+                if fixed[vi] && corners.iter().all(|&i| fixed[i]) {
+                    continue;
+                }
+                let (q, _) = closest_point_triangle(start[vi], start[corners[0]], start[corners[1]], start[corners[2]]);
+                if (q - start[vi]).length() < delta + motion(vi) + tri_motion {
+                    let m = 0.25 * (mass[vi] + corners.iter().map(|&i| mass[i]).sum::<f64>());
+                    pairs.push(SelfPair { vertex: v, triangle: *t, stiffness: self.settings.stiffness * m / (h * h) });
+                }
+            }
+        }
+        pairs
+    }
+
+    /// The continuous-collision fail-safe: finds vertex–triangle and edge–edge pairs that
+    /// cross between `start` and `end`, holds their vertices at `start` and gives each
+    /// impact zone its mean velocity. Returns the number of crossings stopped.
+    pub fn stop_self_crossings(&self, start: &[DVec3], end: &mut [DVec3], v: &mut [DVec3], mass: &[f64], triangles: &[[u32; 3]], edges: &[[u32; 2]]) -> u64 {
+        let n = start.len();
+        let eps = 1e-3 * self.settings.self_thickness;
+        let mut zone: Vec<u32> = (0..n as u32).collect();
+        fn root(zone: &mut [u32], mut i: u32) -> u32 {
+            while zone[i as usize] != i {
+                zone[i as usize] = zone[zone[i as usize] as usize];
+                i = zone[i as usize];
+            }
+            i
+        }
+        let mut stopped = 0u64;
+        let mut frozen = vec![false; n];
+        for _round in 0..50 {
+            let crossings = find_crossings(start, end, triangles, edges, eps);
+            if crossings.is_empty() {
+                break;
+            }
+            stopped += crossings.len() as u64;
+            for group in crossings {
+                let r0 = root(&mut zone, group[0]);
+                for &i in &group {
+                    let r = root(&mut zone, i);
+                    zone[r as usize] = r0;
+                    frozen[i as usize] = true;
+                }
+            }
+            for i in 0..n {
+                if frozen[i] {
+                    end[i] = start[i];
+                }
+            }
+        }
+        if stopped > 0 {
+            // Each zone moves on with its mass-weighted mean velocity (momentum kept).
+            let mut sums: std::collections::HashMap<u32, (DVec3, f64)> = std::collections::HashMap::new();
+            for i in 0..n {
+                if frozen[i] {
+                    let e = sums.entry(root(&mut zone, i as u32)).or_insert((DVec3::ZERO, 0.0));
+                    e.0 += mass[i] * v[i];
+                    e.1 += mass[i];
+                }
+            }
+            for i in 0..n {
+                if frozen[i] {
+                    let (p, m) = sums[&root(&mut zone, i as u32)];
+                    v[i] = p / m;
+                }
+            }
+        }
+        stopped
+    }
+}
+
+fn mean_edge(x: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    let sum: f64 = triangles.iter().take(64).map(|t| (x[t[1] as usize] - x[t[0] as usize]).length()).sum();
+    sum / triangles.len().clamp(1, 64) as f64
+}
+
+/// Groups of vertices of pairs that cross over the step.
+fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], eps: f64) -> Vec<Vec<u32>> {
+    let cell = mean_edge(start, triangles).max(1e-6);
+    let swept = |i: usize| (start[i].min(end[i]), start[i].max(end[i]));
+    let mut vertices = SpatialHash::new(cell);
+    for i in 0..start.len() {
+        let (lo, hi) = swept(i);
+        vertices.insert_box(i as u32, lo, hi);
+    }
+    let mut found = Vec::new();
+    let mut seen = Vec::new();
+    let moving = |i: usize| start[i] != end[i];
+    for t in triangles {
+        let c = t.map(|i| i as usize);
+        let lo = c.iter().fold(DVec3::INFINITY, |a, &i| a.min(swept(i).0)) - DVec3::splat(eps);
+        let hi = c.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(swept(i).1)) + DVec3::splat(eps);
+        seen.clear();
+        vertices.query_box(lo, hi, |v| {
+            if !t.contains(&v) && !seen.contains(&v) {
+                seen.push(v);
+            }
+        });
+        for &v in &seen {
+            let p = v as usize;
+            if !moving(p) && c.iter().all(|&i| !moving(i)) {
+                continue;
+            }
+            let path = |i: usize| [start[i], end[i]];
+            if vertex_triangle_ccd(path(p), path(c[0]), path(c[1]), path(c[2]), eps).is_some() {
+                found.push(vec![v, t[0], t[1], t[2]]);
+            }
+        }
+    }
+    let mut edge_hash = SpatialHash::new(cell);
+    for (e, [a, b]) in edges.iter().enumerate() {
+        let (a, b) = (*a as usize, *b as usize);
+        let lo = swept(a).0.min(swept(b).0) - DVec3::splat(eps);
+        let hi = swept(a).1.max(swept(b).1) + DVec3::splat(eps);
+        edge_hash.insert_box(e as u32, lo, hi);
+    }
+    for (e, [a, b]) in edges.iter().enumerate() {
+        let (a, b) = (*a as usize, *b as usize);
+        let lo = swept(a).0.min(swept(b).0);
+        let hi = swept(a).1.max(swept(b).1);
+        seen.clear();
+        edge_hash.query_box(lo, hi, |f| {
+            if (f as usize) > e && !seen.contains(&f) {
+                seen.push(f);
+            }
+        });
+        for &f in &seen {
+            let [c, d] = edges[f as usize].map(|i| i as usize);
+            if c == a || c == b || d == a || d == b {
+                continue;
+            }
+            if !moving(a) && !moving(b) && !moving(c) && !moving(d) {
+                continue;
+            }
+            let path = |i: usize| [start[i], end[i]];
+            if edge_edge_ccd(path(a), path(b), path(c), path(d), eps).is_some() {
+                found.push(vec![a as u32, b as u32, c as u32, d as u32]);
+            }
+        }
+    }
+    found
+}
+
+/// Edge–triangle crossings in a mesh (edges that share no vertex with the triangle).
+pub fn count_self_intersections(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]]) -> usize {
+    let cell = mean_edge(x, triangles).max(1e-6);
+    let mut hash = SpatialHash::new(cell);
+    for (t, tri) in triangles.iter().enumerate() {
+        let c = tri.map(|i| x[i as usize]);
+        hash.insert_box(t as u32, c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+    }
+    let mut count = 0;
+    let mut seen = Vec::new();
+    for [a, b] in edges {
+        let (p, q) = (x[*a as usize], x[*b as usize]);
+        seen.clear();
+        hash.query_box(p.min(q), p.max(q), |t| {
+            if !seen.contains(&t) {
+                seen.push(t);
+            }
+        });
+        for &t in &seen {
+            let tri = triangles[t as usize];
+            if tri.contains(a) || tri.contains(b) {
+                continue;
+            }
+            let c = tri.map(|i| x[i as usize]);
+            if segment_crosses_triangle(p, q, c[0], c[1], c[2]) {
+                count += 1;
+            }
+        }
+    }
+    count
+}
+
+impl StepContacts {
+    pub fn is_empty(&self) -> bool {
+        self.planes.is_empty() && self.pairs.is_empty()
+    }
+
+    pub fn plane_count(&self) -> usize {
+        self.planes.len()
+    }
+
+    pub fn pair_count(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Friction dissipation function F(s) and F'(s) of the tangential slip s over the step.
+    fn friction(&self, s: f64) -> (f64, f64) {
+        let (e, ms, mk) = (self.slip, self.mu_static, self.mu_kinetic);
+        if s <= e {
+            (ms * s * s / (2.0 * e), ms * s / e)
+        } else {
+            let decay = (-(s - e) / e).exp();
+            (ms * e / 2.0 + mk * (s - e) + (ms - mk) * e * (1.0 - decay), mk + (ms - mk) * decay)
+        }
+    }
+
+    fn self_distance(&self, pair: &SelfPair, y: &[DVec3]) -> (f64, DVec3, [f64; 3]) {
+        let c = pair.triangle.map(|i| y[i as usize]);
+        let p = y[pair.vertex as usize];
+        let (q, w) = closest_point_triangle(p, c[0], c[1], c[2]);
+        let offset = p - q;
+        let d = offset.length();
+        (d, if d > 1e-15 { offset / d } else { DVec3::Z }, w)
+    }
+
+    /// Contact energy plus friction dissipation at positions `y`; `anchor` is x̂ (the
+    /// position the step's velocity is measured from).
+    pub fn energy(&self, y: &[DVec3], anchor: &[DVec3]) -> f64 {
+        let mut e = 0.0;
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let gap = self.thickness - c.normal.dot(y[i] - c.point);
+            if gap > 0.0 {
+                e += 0.5 * c.stiffness * gap * gap;
+            }
+            if c.normal_force > 0.0 {
+                let u = y[i] - anchor[i];
+                let slip = (u - u.dot(c.normal) * c.normal).length();
+                e += c.normal_force * self.friction(slip).0;
+            }
+        }
+        for p in &self.pairs {
+            let (d, _, _) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                e += 0.5 * p.stiffness * (self.self_thickness - d).powi(2);
+            }
+        }
+        e
+    }
+
+    /// Adds ∇(energy) to `g`.
+    pub fn add_gradient(&self, y: &[DVec3], anchor: &[DVec3], g: &mut [DVec3], fixed: &[bool]) {
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let gap = self.thickness - c.normal.dot(y[i] - c.point);
+            if gap > 0.0 {
+                g[i] -= c.stiffness * gap * c.normal;
+            }
+            if c.normal_force > 0.0 {
+                let u = y[i] - anchor[i];
+                let t = u - u.dot(c.normal) * c.normal;
+                let slip = t.length();
+                if slip > 0.0 {
+                    g[i] += c.normal_force * self.friction(slip).1 * t / slip;
+                }
+            }
+        }
+        for p in &self.pairs {
+            let (d, n, w) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                let f = p.stiffness * (self.self_thickness - d);
+                let v = p.vertex as usize;
+                if !fixed[v] {
+                    g[v] -= f * n;
+                }
+                for k in 0..3 {
+                    let j = p.triangle[k] as usize;
+                    if !fixed[j] {
+                        g[j] += f * w[k] * n;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds a positive semi-definite approximation of the energy's Hessian to the diagonal
+    /// blocks of `k` (couplings between a vertex and a triangle are left out; the line
+    /// search keeps Newton descending).
+    pub fn add_hessian(&self, y: &[DVec3], anchor: &[DVec3], k: &mut BlockCsr) {
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let mut block = DMat3::ZERO;
+            if self.thickness - c.normal.dot(y[i] - c.point) > 0.0 {
+                block += c.stiffness * outer(c.normal, c.normal);
+            }
+            if c.normal_force > 0.0 {
+                let u = y[i] - anchor[i];
+                let slip = (u - u.dot(c.normal) * c.normal).length();
+                let tangent = DMat3::IDENTITY - outer(c.normal, c.normal);
+                let (_, dfriction) = self.friction(slip.max(self.slip));
+                block += tangent * (c.normal_force * dfriction / slip.max(self.slip));
+            }
+            let slot = k.diagonal_slot(i as u32);
+            k.values[slot] += block;
+        }
+        for p in &self.pairs {
+            let (d, n, w) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                let nn = outer(n, n) * p.stiffness;
+                let slot = k.diagonal_slot(p.vertex);
+                k.values[slot] += nn;
+                for m in 0..3 {
+                    let slot = k.diagonal_slot(p.triangle[m]);
+                    k.values[slot] += nn * (w[m] * w[m]);
+                }
+            }
+        }
+    }
+}
+
+fn outer(a: DVec3, b: DVec3) -> DMat3 {
+    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}

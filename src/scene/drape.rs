@@ -1,0 +1,167 @@
+//! Drape measurements (BS 5058 / ISO 9073-9, REFERENCE §7): the shadow of the draped cloth
+//! on the horizontal plane, its area, its outline in polar form, the drape coefficient and
+//! the number of folds (nodes).
+
+use glam::{DVec2, DVec3};
+
+/// The vertical projection of the cloth, rasterised.
+pub struct Shadow {
+    /// Area of the union of the projected triangles, m².
+    pub area: f64,
+    /// Outline radius from the centre at each angle: (angle rad, radius m), ascending.
+    pub outline: Vec<(f64, f64)>,
+}
+
+/// Angular resolution of the outline: half a degree.
+const OUTLINE_BINS: usize = 720;
+
+/// Projects the triangles on z = 0 and rasterises their union on a square grid of
+/// `resolution` cells a side around `centre`; the outline is the farthest covered cell
+/// along each ray from `centre`. Rasterising is used (not polygon clipping) because the
+/// union of thousands of overlapping triangles of a folded cloth is what the standard's
+/// light box sees, and a grid gives it exactly up to the cell size.
+pub fn shadow(x: &[DVec3], triangles: &[[u32; 3]], centre: DVec2, resolution: usize) -> Shadow {
+    let reach = x.iter().map(|p| (p.truncate() - centre).abs().max_element()).fold(0.0, f64::max) * 1.001 + 1e-9;
+    let cell = 2.0 * reach / resolution as f64;
+    let origin = centre - DVec2::splat(reach);
+    let mut covered = vec![false; resolution * resolution];
+    for t in triangles {
+        let p = t.map(|i| (x[i as usize].truncate() - origin) / cell);
+        let lo = p[0].min(p[1]).min(p[2]).floor().max(DVec2::ZERO);
+        let hi = p[0].max(p[1]).max(p[2]).ceil().min(DVec2::splat(resolution as f64 - 1.0));
+        let area2 = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+        if area2.abs() < 1e-14 {
+            continue;
+        }
+        for j in lo.y as usize..=hi.y as usize {
+            for i in lo.x as usize..=hi.x as usize {
+                // Cell centres inside the triangle (edge functions, either orientation).
+                let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                let w0 = (p[1] - c).perp_dot(p[2] - c);
+                let w1 = (p[2] - c).perp_dot(p[0] - c);
+                let w2 = (p[0] - c).perp_dot(p[1] - c);
+                let inside = if area2 > 0.0 { w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0 } else { w0 <= 0.0 && w1 <= 0.0 && w2 <= 0.0 };
+                if inside {
+                    covered[j * resolution + i] = true;
+                }
+            }
+        }
+    }
+    let area = covered.iter().filter(|&&c| c).count() as f64 * cell * cell;
+    let mut outline = Vec::with_capacity(OUTLINE_BINS);
+    let steps = 2 * resolution;
+    for k in 0..OUTLINE_BINS {
+        let angle = 2.0 * std::f64::consts::PI * k as f64 / OUTLINE_BINS as f64;
+        let dir = DVec2::from_angle(angle);
+        let mut radius = 0.0;
+        for s in 0..steps {
+            let r = reach * 1.5 * s as f64 / steps as f64;
+            let q = (centre + r * dir - origin) / cell;
+            if q.x < 0.0 || q.y < 0.0 || q.x >= resolution as f64 || q.y >= resolution as f64 {
+                break;
+            }
+            if covered[q.y as usize * resolution + q.x as usize] {
+                radius = r;
+            }
+        }
+        outline.push((angle, radius));
+    }
+    Shadow { area, outline }
+}
+
+/// Drape coefficient DC = (A_shadow − A_support)/(A_specimen − A_support).
+pub fn drape_coefficient(shadow_area: f64, specimen_area: f64, support_area: f64) -> f64 {
+    (shadow_area - support_area) / (specimen_area - support_area)
+}
+
+/// Number of folds: peaks of the outline radius around the circle, after smoothing over
+/// `smoothing` radians, that stand out from the troughs on both sides by more than
+/// `prominence` metres.
+pub fn count_nodes(outline: &[(f64, f64)], smoothing: f64, prominence: f64) -> usize {
+    let n = outline.len();
+    if n < 8 {
+        return 0;
+    }
+    let half = ((smoothing / (2.0 * std::f64::consts::PI) * n as f64) / 2.0).round() as isize;
+    let r: Vec<f64> = (0..n as isize)
+        .map(|i| {
+            let sum: f64 = (-half..=half).map(|k| outline[(i + k).rem_euclid(n as isize) as usize].1).sum();
+            sum / (2 * half + 1) as f64
+        })
+        .collect();
+    // Walk around from the global minimum; a peak counts when the radius has risen more
+    // than `prominence` above the last trough and later falls that much below it.
+    let start = (0..n).min_by(|&a, &b| r[a].total_cmp(&r[b])).unwrap_or(0);
+    let mut peaks = 0;
+    let mut trough = r[start];
+    let mut crest = f64::NEG_INFINITY;
+    let mut rising = true;
+    for k in 1..=n {
+        let v = r[(start + k) % n];
+        if rising {
+            crest = crest.max(v);
+            if crest - v > prominence && crest - trough > prominence {
+                peaks += 1;
+                rising = false;
+                trough = v;
+            }
+        } else {
+            trough = trough.min(v);
+            if v - trough > prominence {
+                rising = true;
+                crest = v;
+            }
+        }
+    }
+    peaks
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A flat star-shaped polygon fan around the origin with radius r(θ).
+    fn fan(radius: impl Fn(f64) -> f64, segments: usize) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+        let mut x = vec![DVec3::ZERO];
+        let mut t = Vec::new();
+        for k in 0..segments {
+            let a = 2.0 * std::f64::consts::PI * k as f64 / segments as f64;
+            x.push(DVec3::new(radius(a) * a.cos(), radius(a) * a.sin(), 0.0));
+            t.push([0, k as u32 + 1, ((k + 1) % segments) as u32 + 1]);
+        }
+        (x, t)
+    }
+
+    #[test]
+    fn disc_shadow_area_and_outline() {
+        let (x, t) = fan(|_| 0.18, 720);
+        let s = shadow(&x, &t, DVec2::ZERO, 1024);
+        let exact = std::f64::consts::PI * 0.18f64.powi(2);
+        assert!((s.area / exact - 1.0).abs() < 2e-3, "{} vs {exact}", s.area);
+        assert!(s.outline.iter().all(|(_, r)| (r - 0.18).abs() < 1e-3));
+        assert_eq!(count_nodes(&s.outline, 0.1, 0.005), 0);
+    }
+
+    #[test]
+    fn nodes_of_a_wavy_outline() {
+        for nodes in [4usize, 6, 9] {
+            let (x, t) = fan(|a| 0.14 + 0.02 * (nodes as f64 * a + 0.3).cos(), 1440);
+            let s = shadow(&x, &t, DVec2::ZERO, 1024);
+            assert_eq!(count_nodes(&s.outline, 0.1, 0.005), nodes);
+        }
+        // Overlapping layers count once.
+        let (mut x, mut t) = fan(|_| 0.1, 360);
+        let (x2, t2) = fan(|_| 0.1, 360);
+        let offset = x.len() as u32;
+        x.extend(x2);
+        t.extend(t2.iter().map(|tri| tri.map(|i| i + offset)));
+        let s = shadow(&x, &t, DVec2::ZERO, 1024);
+        assert!((s.area / (std::f64::consts::PI * 0.01) - 1.0).abs() < 3e-3);
+    }
+
+    #[test]
+    fn drape_coefficient_bounds() {
+        assert_eq!(drape_coefficient(1.0, 1.0, 0.25), 1.0);
+        assert_eq!(drape_coefficient(0.25, 1.0, 0.25), 0.0);
+    }
+}
