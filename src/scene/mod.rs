@@ -148,13 +148,13 @@ fn drape_mesh(config: &SceneConfig) -> Result<Mesh, SceneError> {
 }
 
 /// Drape scenes start from a flat cloth lifted by a smooth random ripple: a sum of angular
-/// modes k = 2..12 with random phases and amplitudes, growing with the square of the
+/// modes k = 2..12 with random phases, growing with the square of the
 /// distance from the centre. Unlike noise per vertex it is the same surface whatever the
 /// mesh, so runs at different resolutions start alike, and it breaks the symmetry that
 /// would otherwise leave a perfect disc undecided where to fold.
 fn perturb_smoothly(x: &mut [DVec3], model: &Model, origin: DVec3, amplitude: f64, rng: &mut impl Rng) {
-    let modes: Vec<(f64, f64, f64)> =
-        (2..=12).map(|k| (k as f64, rng.random_range(0.0..1.0), rng.random_range(0.0..std::f64::consts::TAU))).collect();
+    // Equal amplitudes and random phases: no fold count is favoured, the fabric picks it.
+    let modes: Vec<(f64, f64, f64)> = (2..=12).map(|k| (k as f64, 1.0, rng.random_range(0.0..std::f64::consts::TAU))).collect();
     let norm: f64 = modes.iter().map(|m| m.1).sum();
     let reach = model.rest.iter().map(|p| p.length()).fold(0.0, f64::max).max(1e-9);
     for (i, p) in x.iter_mut().enumerate() {

@@ -247,13 +247,27 @@ impl Integrator {
         }
         let step = ImplicitStep { model, h, anchor: &anchor, inertial: &inertial };
         let mut report = StepReport::default();
+        let mut step_contacts = None;
         match &model.contact {
             None => self.newton(&step, None, &mut y, &mut report),
             Some(contact) => {
                 // The prediction includes gravity's pull over the step, so that contacts a
                 // falling cloth is about to make are there from the first iteration.
                 let predicted: Vec<DVec3> = (0..n).map(|i| inertial[i] + h * h * model.options.gravity).collect();
-                let mut contacts = contact.begin_step(&s.x, &predicted, &model.fixed, &model.mass, &model.triangles, h);
+                let mut contacts = contact.begin_step(&s.x, &predicted, &model.fixed, &model.mass, &model.triangles, &model.edges, h);
+                // Newton's path must start where the cloth is: jumping straight to the
+                // inertial guess could carry a vertex through a layer before any contact
+                // force acts. Start from x_n moved towards the guess as far as no cloth–cloth
+                // pair can meet.
+                if contacts.pair_count() > 0 {
+                    let guess: Vec<DVec3> = (0..n).map(|i| if model.fixed[i] { DVec3::ZERO } else { y[i] - s.x[i] }).collect();
+                    let alpha = contacts.max_step(&s.x, &guess);
+                    for i in 0..n {
+                        if !model.fixed[i] {
+                            y[i] = s.x[i] + alpha * guess[i];
+                        }
+                    }
+                }
                 // Solve; a path that enters a prop without a plane adds one and solves again.
                 for pass in 0..4 {
                     self.newton(&step, Some(&contacts), &mut y, &mut report);
@@ -265,12 +279,22 @@ impl Integrator {
                         report.newton_unconverged = true;
                     }
                 }
+                step_contacts = Some(contacts);
             }
         }
-        let previous = (s.x.clone(), s.v.clone());
+        let mut previous = (s.x.clone(), s.v.clone());
         let start = s.x.clone();
         for i in 0..n {
             s.v[i] = (y[i] - anchor[i]) / h;
+        }
+        if let Some(contacts) = &step_contacts {
+            // A vertex whose rebound was absorbed gets a history of steady motion at its new
+            // velocity, or BDF2's extrapolation from its falling past would lift it again.
+            for i in contacts.absorb_rebound(&y, &mut s.v) {
+                let i = i as usize;
+                previous.0[i] = y[i] - dt * s.v[i];
+                previous.1[i] = s.v[i];
+            }
         }
         s.x = y;
         if let Some(contact) = &model.contact {
@@ -307,6 +331,7 @@ impl Integrator {
         let all_free = !model.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
         report.newton_unconverged = true;
         let mut phi_current: Option<f64> = None;
+        let mut couplings = Vec::new();
         for _ in 0..self.newton.max_iterations {
             self.forces.resize(n, DVec3::ZERO);
             model.forces(y, &mut self.forces);
@@ -327,6 +352,8 @@ impl Integrator {
                     }
                 }
                 c.add_hessian(y, anchor, &mut stiffness);
+                couplings.clear();
+                c.couplings(y, &mut couplings);
             }
             let bending = model.bending_newton_matrix(y);
             let system = SystemMatrix {
@@ -334,6 +361,7 @@ impl Integrator {
                 stiffness: &stiffness,
                 bending: bending.as_deref(),
                 fixed: &model.fixed,
+                couplings: &couplings,
             };
             let rhs: Vec<DVec3> = gradient.iter().map(|g| -*g).collect();
             let cg = pcg(&system, &rhs, &mut direction, self.newton.cg_tolerance, self.newton.cg_max_iterations);
@@ -363,7 +391,7 @@ impl Integrator {
             let slope: f64 = gradient.iter().zip(&direction).map(|(g, d)| g.dot(*d)).sum();
             // Φ at the current iterate is the previous iteration's accepted trial value.
             let phi0 = *phi_current.get_or_insert_with(|| objective(y));
-            let mut alpha = 1.0;
+            let mut alpha = contacts.map_or(1.0, |c| c.max_step(y, &direction));
             let mut accepted = false;
             let mut phi = phi0;
             for _ in 0..30 {

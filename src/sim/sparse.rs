@@ -141,6 +141,19 @@ pub struct SystemMatrix<'a> {
     pub bending: Option<&'a ScalarCsr>,
     /// `true` for vertices whose positions are prescribed (their rows and columns are dropped).
     pub fixed: &'a [bool],
+    /// Rank-one couplings k·g gᵀ between a few vertices (cloth–cloth contact), whose
+    /// diagonal blocks are already in `stiffness`: only their off-diagonal part is applied.
+    pub couplings: &'a [Coupling],
+}
+
+/// A rank-one term k·g gᵀ of the system matrix with g = (c₀n, c₁n, c₂n, c₃n) on four
+/// vertices: the Gauss–Newton Hessian of a penalty on one distance.
+#[derive(Debug, Clone, Copy)]
+pub struct Coupling {
+    pub vertices: [u32; 4],
+    pub weights: [f64; 4],
+    pub normal: DVec3,
+    pub stiffness: f64,
 }
 
 impl SystemMatrix<'_> {
@@ -148,6 +161,13 @@ impl SystemMatrix<'_> {
         self.stiffness.multiply(x, y);
         if let Some(q) = self.bending {
             q.multiply_add(x, y);
+        }
+        for c in self.couplings {
+            let along = |j: usize| c.weights[j] * c.normal.dot(x[c.vertices[j] as usize]);
+            let total: f64 = (0..4).map(along).sum();
+            for j in 0..4 {
+                y[c.vertices[j] as usize] += c.stiffness * c.weights[j] * (total - along(j)) * c.normal;
+            }
         }
         for i in 0..y.len() {
             y[i] = if self.fixed[i] { DVec3::ZERO } else { y[i] + self.mass_diagonal[i] * x[i] };
@@ -390,7 +410,7 @@ mod tests {
         }
         let mass = [1.0, 2.0, 3.0];
         let fixed = [false; 3];
-        let a = SystemMatrix { mass_diagonal: &mass, stiffness: &k, bending: None, fixed: &fixed };
+        let a = SystemMatrix { mass_diagonal: &mass, stiffness: &k, bending: None, fixed: &fixed, couplings: &[] };
         let b = vec![DVec3::new(1.0, 0.0, 2.0), DVec3::new(-1.0, 3.0, 0.0), DVec3::new(0.5, 0.5, 0.5)];
         let mut x = vec![DVec3::ZERO; 3];
         let report = pcg(&a, &b, &mut x, 1e-12, 100);

@@ -34,8 +34,8 @@ pub mod props;
 
 pub use props::{Prop, PropError, PropShape, SurfacePoint};
 
-use crate::sim::sparse::BlockCsr;
-use geometry::{SpatialHash, closest_point_triangle, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
+use crate::sim::sparse::{BlockCsr, Coupling};
+use geometry::{SpatialHash, closest_point_triangle, closest_points_segments, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
 use glam::{DMat3, DVec3};
 
 /// Contact parameters, SI units.
@@ -113,11 +113,12 @@ struct PlaneContact {
     normal_force: f64,
 }
 
-/// A vertex kept away from a triangle of the cloth over one step.
+/// Two parts of the cloth kept apart over one step: a vertex and a triangle, or two edges.
 #[derive(Debug, Clone, Copy)]
 struct SelfPair {
-    vertex: u32,
-    triangle: [u32; 3],
+    /// Vertex then triangle corners, or the first edge's ends then the second's.
+    vertices: [u32; 4],
+    edge_edge: bool,
     stiffness: f64,
 }
 
@@ -174,7 +175,17 @@ impl ContactModel {
 
     /// The contacts for a step from `start` (positions x_n) towards `predicted` (x_n + h v_n
     /// or the BDF2 equivalent), with time step `h` and vertex masses.
-    pub fn begin_step(&self, start: &[DVec3], predicted: &[DVec3], fixed: &[bool], mass: &[f64], triangles: &[[u32; 3]], h: f64) -> StepContacts {
+    #[allow(clippy::too_many_arguments)]
+    pub fn begin_step(
+        &self,
+        start: &[DVec3],
+        predicted: &[DVec3],
+        fixed: &[bool],
+        mass: &[f64],
+        triangles: &[[u32; 3]],
+        edges: &[[u32; 2]],
+        h: f64,
+    ) -> StepContacts {
         let s = &self.settings;
         let mut contacts = StepContacts {
             planes: Vec::new(),
@@ -190,8 +201,12 @@ impl ContactModel {
                 self.add_planes(v, start[v], predicted[v], mass[v], h, &mut contacts.planes, false);
             }
         }
+        if std::env::var("ROSETTE_DEBUG_LAMBDA").is_ok() {
+            let total: f64 = contacts.planes.iter().map(|c| c.normal_force).sum();
+            eprintln!("planes {} total normal force {total}", contacts.planes.len());
+        }
         if s.self_collision {
-            contacts.pairs = self.self_pairs(start, predicted, fixed, mass, triangles, h);
+            contacts.pairs = self.self_pairs(start, predicted, fixed, mass, triangles, edges, h);
         }
         contacts
     }
@@ -309,7 +324,17 @@ impl ContactModel {
     }
 
     /// Vertex–triangle pairs within reach over the step.
-    fn self_pairs(&self, start: &[DVec3], predicted: &[DVec3], fixed: &[bool], mass: &[f64], triangles: &[[u32; 3]], h: f64) -> Vec<SelfPair> {
+    #[allow(clippy::too_many_arguments)]
+    fn self_pairs(
+        &self,
+        start: &[DVec3],
+        predicted: &[DVec3],
+        fixed: &[bool],
+        mass: &[f64],
+        triangles: &[[u32; 3]],
+        edges: &[[u32; 2]],
+        h: f64,
+    ) -> Vec<SelfPair> {
         let delta = self.settings.self_thickness;
         let motion = |v: usize| (predicted[v] - start[v]).length();
         let cell = mean_edge(start, triangles).max(2.0 * delta);
@@ -339,7 +364,42 @@ impl ContactModel {
                 let (q, _) = closest_point_triangle(start[vi], start[corners[0]], start[corners[1]], start[corners[2]]);
                 if (q - start[vi]).length() < delta + motion(vi) + tri_motion {
                     let m = 0.25 * (mass[vi] + corners.iter().map(|&i| mass[i]).sum::<f64>());
-                    pairs.push(SelfPair { vertex: v, triangle: *t, stiffness: self.settings.stiffness * m / (h * h) });
+                    pairs.push(SelfPair { vertices: [v, t[0], t[1], t[2]], edge_edge: false, stiffness: self.settings.stiffness * m / (h * h) });
+                }
+            }
+        }
+        // Edges can pass through each other with every vertex far from every triangle.
+        let mut edge_hash = SpatialHash::new(cell);
+        let swept = |i: usize| (start[i].min(predicted[i]), start[i].max(predicted[i]));
+        for (e, [a, b]) in edges.iter().enumerate() {
+            let (a, b) = (*a as usize, *b as usize);
+            edge_hash.insert_box(e as u32, swept(a).0.min(swept(b).0), swept(a).1.max(swept(b).1));
+        }
+        for (e, [a, b]) in edges.iter().enumerate() {
+            let (a, b) = (*a as usize, *b as usize);
+            let lo = swept(a).0.min(swept(b).0) - DVec3::splat(delta);
+            let hi = swept(a).1.max(swept(b).1) + DVec3::splat(delta);
+            seen.clear();
+            edge_hash.query_box(lo, hi, |f| {
+                if (f as usize) > e && !seen.contains(&f) {
+                    seen.push(f);
+                }
+            });
+            for &f in &seen {
+                let [c, d] = edges[f as usize].map(|i| i as usize);
+                if c == a || c == b || d == a || d == b || (fixed[a] && fixed[b] && fixed[c] && fixed[d]) {
+                    continue;
+                }
+                let (sa, tb) = closest_points_segments(start[a], start[b], start[c], start[d]);
+                let gap = (start[a].lerp(start[b], sa) - start[c].lerp(start[d], tb)).length();
+                let reach = delta + motion(a).max(motion(b)) + motion(c).max(motion(d));
+                if gap < reach {
+                    let m = 0.25 * (mass[a] + mass[b] + mass[c] + mass[d]);
+                    pairs.push(SelfPair {
+                        vertices: [a as u32, b as u32, c as u32, d as u32],
+                        edge_edge: true,
+                        stiffness: self.settings.stiffness * m / (h * h),
+                    });
                 }
             }
         }
@@ -368,6 +428,10 @@ impl ContactModel {
                 break;
             }
             stopped += crossings.len() as u64;
+            if std::env::var("ROSETTE_DEBUG").is_ok() {
+                let g = &crossings[0];
+                eprintln!("round {_round}: {} crossings, first {:?} start {:?} end {:?}", crossings.len(), g, g.iter().map(|&i| start[i as usize]).collect::<Vec<_>>(), g.iter().map(|&i| end[i as usize]).collect::<Vec<_>>());
+            }
             for group in crossings {
                 let r0 = root(&mut zone, group[0]);
                 for &i in &group {
@@ -531,13 +595,19 @@ impl StepContacts {
         }
     }
 
-    fn self_distance(&self, pair: &SelfPair, y: &[DVec3]) -> (f64, DVec3, [f64; 3]) {
-        let c = pair.triangle.map(|i| y[i as usize]);
-        let p = y[pair.vertex as usize];
-        let (q, w) = closest_point_triangle(p, c[0], c[1], c[2]);
-        let offset = p - q;
+    /// Distance of a pair at `y`, the unit direction from the second part to the first, and
+    /// the weights c with d = n·Σ c_j y_j (to first order).
+    fn self_distance(&self, pair: &SelfPair, y: &[DVec3]) -> (f64, DVec3, [f64; 4]) {
+        let p = pair.vertices.map(|i| y[i as usize]);
+        let (offset, weights) = if pair.edge_edge {
+            let (s, t) = closest_points_segments(p[0], p[1], p[2], p[3]);
+            (p[0].lerp(p[1], s) - p[2].lerp(p[3], t), [1.0 - s, s, t - 1.0, -t])
+        } else {
+            let (q, w) = closest_point_triangle(p[0], p[1], p[2], p[3]);
+            (p[0] - q, [1.0, -w[0], -w[1], -w[2]])
+        };
         let d = offset.length();
-        (d, if d > 1e-15 { offset / d } else { DVec3::Z }, w)
+        (d, if d > 1e-15 { offset / d } else { DVec3::Z }, weights)
     }
 
     /// Contact energy plus friction dissipation at positions `y`; `anchor` is x̂ (the
@@ -586,14 +656,10 @@ impl StepContacts {
             let (d, n, w) = self.self_distance(p, y);
             if d < self.self_thickness {
                 let f = p.stiffness * (self.self_thickness - d);
-                let v = p.vertex as usize;
-                if !fixed[v] {
-                    g[v] -= f * n;
-                }
-                for k in 0..3 {
-                    let j = p.triangle[k] as usize;
+                for k in 0..4 {
+                    let j = p.vertices[k] as usize;
                     if !fixed[j] {
-                        g[j] += f * w[k] * n;
+                        g[j] -= f * w[k] * n;
                     }
                 }
             }
@@ -601,8 +667,9 @@ impl StepContacts {
     }
 
     /// Adds a positive semi-definite approximation of the energy's Hessian to the diagonal
-    /// blocks of `k` (couplings between a vertex and a triangle are left out; the line
-    /// search keeps Newton descending).
+    /// blocks of `k`; the cloth–cloth pairs' off-diagonal parts come from
+    /// [`StepContacts::couplings`]. Both are Gauss–Newton (the normal's rotation is left
+    /// out), which keeps the system positive definite.
     pub fn add_hessian(&self, y: &[DVec3], anchor: &[DVec3], k: &mut BlockCsr) {
         for c in &self.planes {
             let i = c.vertex as usize;
@@ -624,12 +691,63 @@ impl StepContacts {
             let (d, n, w) = self.self_distance(p, y);
             if d < self.self_thickness {
                 let nn = outer(n, n) * p.stiffness;
-                let slot = k.diagonal_slot(p.vertex);
-                k.values[slot] += nn;
-                for m in 0..3 {
-                    let slot = k.diagonal_slot(p.triangle[m]);
+                for m in 0..4 {
+                    let slot = k.diagonal_slot(p.vertices[m]);
                     k.values[slot] += nn * (w[m] * w[m]);
                 }
+            }
+        }
+    }
+}
+
+impl StepContacts {
+    /// Makes prop contact inelastic: a vertex still inside its contact layer at the end of
+    /// the step keeps no velocity away from the prop. The penalty is a spring, and BDF2,
+    /// which hardly damps, would otherwise give back its energy as a bounce (a dropped
+    /// cloth jumped back to 90 % of its height); cloth does not bounce.
+    /// Returns the vertices whose velocity changed.
+    pub fn absorb_rebound(&self, y: &[DVec3], v: &mut [DVec3]) -> Vec<u32> {
+        let mut changed = Vec::new();
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let outward = v[i].dot(c.normal);
+            if outward > 0.0 && self.thickness - c.normal.dot(y[i] - c.point) > 0.0 {
+                v[i] -= outward * c.normal;
+                changed.push(c.vertex);
+            }
+        }
+        changed
+    }
+
+    /// Largest fraction of the Newton direction `d` from `y` along which no cloth–cloth
+    /// pair can meet (additive CCD, Li et al. 2021): a pair at distance g whose vertices move
+    /// at most |d_p| + max|d_j| cannot close that gap over a step shorter than g divided by it.
+    /// Capping each line search there keeps every Newton iterate free of crossings, so the
+    /// solve cannot carry a vertex around a triangle's edge to the far side.
+    pub fn max_step(&self, y: &[DVec3], d: &[DVec3]) -> f64 {
+        let mut alpha = 1.0f64;
+        for p in &self.pairs {
+            let v = p.vertices.map(|i| d[i as usize].length());
+            let bound = if p.edge_edge { v[0].max(v[1]) + v[2].max(v[3]) } else { v[0] + v[1].max(v[2]).max(v[3]) };
+            if bound > 0.0 {
+                let (gap, _, _) = self.self_distance(p, y);
+                alpha = alpha.min(0.9 * gap / bound);
+            }
+        }
+        alpha.max(0.0)
+    }
+
+    /// The rank-one Gauss–Newton terms of the active cloth–cloth pairs at `y`.
+    pub fn couplings(&self, y: &[DVec3], out: &mut Vec<Coupling>) {
+        for p in &self.pairs {
+            let (d, n, w) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                out.push(Coupling {
+                    vertices: p.vertices,
+                    weights: w,
+                    normal: n,
+                    stiffness: p.stiffness,
+                });
             }
         }
     }
