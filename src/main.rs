@@ -28,6 +28,9 @@ enum Command {
         /// Write the metrics JSON to FILE, or to standard output with '-'.
         #[arg(long, value_name = "FILE|-")]
         metrics: Option<String>,
+        /// Drape scenes: write the final shadow outline as CSV (angle_deg, radius_m).
+        #[arg(long, value_name = "FILE.csv")]
+        outline: Option<String>,
     },
     /// List the bundled scenes.
     Presets,
@@ -46,11 +49,13 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Run { preset, overrides, duration, metrics } => run(&preset, &overrides, duration, metrics.as_deref()),
+        Command::Run { preset, overrides, duration, metrics, outline } => {
+            run(&preset, &overrides, duration, metrics.as_deref(), outline.as_deref())
+        }
     }
 }
 
-fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Option<&str>) -> ExitCode {
+fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Option<&str>, outline_out: Option<&str>) -> ExitCode {
     let config = match load_scene(spec, overrides) {
         Ok((config, _)) => config,
         Err(e) => {
@@ -99,6 +104,12 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Opt
         eprintln!("error: {e:#}");
         return ExitCode::from(EXIT_BAD_INPUT);
     }
+    if let Some(path) = outline_out {
+        if let Err(e) = write_outline(&scene, path) {
+            eprintln!("error: {e:#}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    }
     if metrics_out.is_none() {
         eprintln!(
             "{name}: {} steps of {} s with {}, {:.3} s simulated in {:.2} s wall ({:.4} CPU s per 10 ms simulated)",
@@ -113,6 +124,18 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Opt
         }
         None => ExitCode::SUCCESS,
     }
+}
+
+fn write_outline(scene: &Scene, path: &str) -> anyhow::Result<()> {
+    let outline = scene
+        .rig
+        .outline(&scene.model, &scene.state)
+        .with_context(|| format!("--outline: {} is not a drape scene; only drape scenes have a shadow outline", scene.config.scene.description))?;
+    let mut text = String::from("angle_deg,radius_m\n");
+    for (angle, radius) in outline {
+        text += &format!("{:.2},{radius:.6}\n", angle.to_degrees());
+    }
+    std::fs::write(path, text).with_context(|| format!("cannot write the outline to {path}"))
 }
 
 fn write_metrics(metrics: &rosette::scene::Metrics, out: Option<&str>) -> anyhow::Result<()> {

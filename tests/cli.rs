@@ -105,10 +105,30 @@ fn run_bundled(name: &str) {
     assert!(cpu.is_finite() && cpu > 0.0, "{name}: cpu_seconds_per_simulated_second {cpu}");
     let measures = metrics["measures"].as_object().expect("measures is an object");
     assert!(!measures.is_empty(), "{name}: no measurements");
+    if !config.props.is_empty() {
+        let depth = metrics["max_penetration"].as_f64().expect("scenes with props report max_penetration");
+        assert!(depth >= 0.0 && depth < config.contact.thickness, "{name}: max_penetration {depth}");
+        assert_eq!(metrics["self_intersections"].as_u64(), Some(0), "{name}");
+        assert_eq!(metrics["settled"], true, "{name}: a drape runs until it settles");
+        for key in ["drape_coefficient", "nodes", "shadow_area"] {
+            assert!(measures.contains_key(key), "{name}: measures lack {key}");
+        }
+    }
 }
 
 /// Every bundled scene has its own test below (so that they run in parallel).
-const COVERED: [&str; 7] = ["tensile-warp", "tensile-weft", "tensile-bias", "cantilever", "arc", "euler-buckling", "shear-buckling"];
+const COVERED: [&str; 10] = [
+    "tensile-warp",
+    "tensile-weft",
+    "tensile-bias",
+    "cantilever",
+    "arc",
+    "euler-buckling",
+    "shear-buckling",
+    "cusick-drape",
+    "cusick-drape-30",
+    "tablecloth",
+];
 
 #[test]
 fn every_bundled_scene_has_a_run_test() {
@@ -145,6 +165,46 @@ fn runs_arc() {
 #[test]
 fn runs_euler_buckling() {
     run_bundled("euler-buckling");
+}
+
+#[test]
+fn runs_cusick_drape() {
+    run_bundled("cusick-drape");
+}
+
+#[test]
+fn runs_cusick_drape_30() {
+    run_bundled("cusick-drape-30");
+}
+
+#[test]
+fn runs_tablecloth() {
+    run_bundled("tablecloth");
+}
+
+/// `--outline` writes the shadow outline of a drape: one row per half degree, radii between
+/// the pedestal's and the specimen's; other scenes have none and say so.
+#[test]
+fn outline_csv_of_a_drape() {
+    let path = metrics_path("outline").with_extension("csv");
+    let out = rosette(&["run", "cusick-drape-30", "--duration", "0.2", "--outline", path.to_str().unwrap(), "--metrics", "-"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let csv = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("angle_deg,radius_m"));
+    let rows: Vec<(f64, f64)> = lines
+        .map(|l| {
+            let (a, r) = l.split_once(',').unwrap();
+            (a.parse().unwrap(), r.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(rows.len(), 720);
+    assert!(rows.windows(2).all(|w| w[1].0 > w[0].0) && rows[0].0 == 0.0 && rows[719].0 < 360.0);
+    assert!(rows.iter().all(|&(_, r)| r > 0.09 && r <= 0.15 + 1e-3), "radii between the pedestal and the specimen");
+    let out = rosette(&["run", "tensile-warp", "--duration", "0.01", "--outline", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("not a drape scene"), "{}", text(&out.stderr));
 }
 
 #[test]

@@ -96,6 +96,11 @@ impl Scene {
 
     /// Advances one step and samples the rig's measurements on schedule.
     pub fn step(&mut self) -> Result<StepReport, StepError> {
+        if let (Some(ramp), true) = (self.config.scene.gravity_ramp, self.config.physics.gravity) {
+            // Gravity at the end of the step, which is where implicit steps evaluate forces.
+            let t = self.state.time + self.integrator.dt;
+            self.model.options.gravity = DVec3::new(0.0, 0.0, -GRAVITY * (t / ramp).min(1.0));
+        }
         let report = self.integrator.step(&self.model, &mut self.state)?;
         if self.state.steps.is_multiple_of(self.sample_every) {
             self.rig.sample(&self.model, &self.state);

@@ -179,6 +179,11 @@ pub struct SceneSection {
     /// How long the cloth must stay slow to count as settled, s.
     #[serde(default = "default_settle_window")]
     pub settle_window: f64,
+    /// Gravity grows linearly from zero to full over this time, s: the cloth then sinks
+    /// through a sequence of near-equilibria instead of falling, as a specimen lowered onto
+    /// its support does. Absent: full gravity from the start.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity_ramp: Option<f64>,
 }
 
 fn default_settle_window() -> f64 {
@@ -453,6 +458,9 @@ fn check_scene(c: &SceneConfig) -> Result<(), String> {
     positive("scene.settle_window", c.scene.settle_window)?;
     if let Some(v) = c.scene.settle_speed {
         positive("scene.settle_speed", v)?;
+    }
+    if let Some(v) = c.scene.gravity_ramp {
+        positive("scene.gravity_ramp", v)?;
     }
     positive("solver.dt", c.solver.dt)?;
     positive("mesh.edge_length", c.mesh.edge_length)?;

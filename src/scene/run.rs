@@ -87,7 +87,8 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             let t = scene.state.time;
             // Mass-weighted RMS speed: √(2 KE / M).
             let rms = (2.0 * scene.state.kinetic_energy(&scene.model) / total_mass).sqrt();
-            if rms < limit && scene.model.motions_finished(t) {
+            let loads_done = scene.config.scene.gravity_ramp.is_none_or(|ramp| t >= ramp);
+            if rms < limit && scene.model.motions_finished(t) && loads_done {
                 let since = *slow_since.get_or_insert(t);
                 if t - since >= settle_window {
                     settle_time = Some(since);

@@ -201,10 +201,6 @@ impl ContactModel {
                 self.add_planes(v, start[v], predicted[v], mass[v], h, &mut contacts.planes, false);
             }
         }
-        if std::env::var("ROSETTE_DEBUG_LAMBDA").is_ok() {
-            let total: f64 = contacts.planes.iter().map(|c| c.normal_force).sum();
-            eprintln!("planes {} total normal force {total}", contacts.planes.len());
-        }
         if s.self_collision {
             contacts.pairs = self.self_pairs(start, predicted, fixed, mass, triangles, edges, h);
         }
@@ -428,10 +424,6 @@ impl ContactModel {
                 break;
             }
             stopped += crossings.len() as u64;
-            if std::env::var("ROSETTE_DEBUG").is_ok() {
-                let g = &crossings[0];
-                eprintln!("round {_round}: {} crossings, first {:?} start {:?} end {:?}", crossings.len(), g, g.iter().map(|&i| start[i as usize]).collect::<Vec<_>>(), g.iter().map(|&i| end[i as usize]).collect::<Vec<_>>());
-            }
             for group in crossings {
                 let r0 = root(&mut zone, group[0]);
                 for &i in &group {
