@@ -104,11 +104,9 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Opt
         eprintln!("error: {e:#}");
         return ExitCode::from(EXIT_BAD_INPUT);
     }
-    if let Some(path) = outline_out {
-        if let Err(e) = write_outline(&scene, path) {
-            eprintln!("error: {e:#}");
-            return ExitCode::from(EXIT_BAD_INPUT);
-        }
+    if let Some(Err(e)) = outline_out.map(|path| write_outline(&scene, path)) {
+        eprintln!("error: {e:#}");
+        return ExitCode::from(EXIT_BAD_INPUT);
     }
     if metrics_out.is_none() {
         eprintln!(

@@ -648,10 +648,9 @@ impl StepContacts {
             let (d, n, w) = self.self_distance(p, y);
             if d < self.self_thickness {
                 let f = p.stiffness * (self.self_thickness - d);
-                for k in 0..4 {
-                    let j = p.vertices[k] as usize;
-                    if !fixed[j] {
-                        g[j] -= f * w[k] * n;
+                for (&j, &weight) in p.vertices.iter().zip(&w) {
+                    if !fixed[j as usize] {
+                        g[j as usize] -= f * weight * n;
                     }
                 }
             }
@@ -683,9 +682,9 @@ impl StepContacts {
             let (d, n, w) = self.self_distance(p, y);
             if d < self.self_thickness {
                 let nn = outer(n, n) * p.stiffness;
-                for m in 0..4 {
-                    let slot = k.diagonal_slot(p.vertices[m]);
-                    k.values[slot] += nn * (w[m] * w[m]);
+                for (&j, &weight) in p.vertices.iter().zip(&w) {
+                    let slot = k.diagonal_slot(j);
+                    k.values[slot] += nn * (weight * weight);
                 }
             }
         }
