@@ -44,7 +44,12 @@ pub const GRAVITY: f64 = 9.81;
 
 impl Scene {
     pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
-        let fabric = config.fabric.to_fabric().map_err(ModelError::from)?;
+        let fabric = if config.physics.compression_buckling {
+            config.fabric.with_compression_buckling(config.mesh.edge_length).to_fabric()
+        } else {
+            config.fabric.to_fabric()
+        }
+        .map_err(ModelError::from)?;
         let props = props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
         let options = PhysicsOptions {
             membrane: config.physics.membrane,

@@ -301,11 +301,40 @@ pub struct PhysicsSection {
     pub gravity: bool,
     pub bending: bool,
     pub membrane: bool,
+    /// Sub-element buckling: compressive membrane stress along the warp and the weft is
+    /// capped at the Euler load of one element, π²B/ℓ² (ℓ the edge length), beyond which
+    /// it grows at 1 % of the initial tensile slope. A triangle stands for cloth that would
+    /// have buckled within it; without the cap coarse meshes lock in folds. Only where the
+    /// tensile curves give no compression points of their own.
+    pub compression_buckling: bool,
 }
 
 impl Default for PhysicsSection {
     fn default() -> Self {
-        Self { gravity: true, bending: true, membrane: true }
+        Self { gravity: true, bending: true, membrane: true, compression_buckling: false }
+    }
+}
+
+impl FabricConfig {
+    /// The tensile curves with the sub-element buckling branch in compression for elements
+    /// of edge length `edge`, m (see [`PhysicsSection::compression_buckling`]).
+    pub fn with_compression_buckling(&self, edge: f64) -> FabricConfig {
+        let mut f = self.clone();
+        let branch = |curve: &mut Vec<[f64; 2]>, rigidity: f64| {
+            if curve.first().is_none_or(|p| p[0] < 0.0) || curve.len() < 2 || curve[1][0] <= 0.0 {
+                return;
+            }
+            let slope = curve[1][1] / curve[1][0];
+            let critical = std::f64::consts::PI.powi(2) * rigidity / (edge * edge);
+            let knee = critical / slope;
+            // Far enough that no cloth gets there: half its length.
+            let far = 0.5f64.max(2.0 * knee);
+            curve.insert(0, [-knee, -critical]);
+            curve.insert(0, [-far, -critical - 0.01 * slope * (far - knee)]);
+        };
+        branch(&mut f.tensile_warp, self.bending_warp);
+        branch(&mut f.tensile_weft, self.bending_weft);
+        f
     }
 }
 
@@ -440,7 +469,12 @@ pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, Stri
     let mut config: SceneConfig =
         table.try_into().map_err(|e: toml::de::Error| PresetError::Invalid { file: file.clone(), message: describe(&e) })?;
     config.base_dir = base;
-    config.fabric.to_fabric().map_err(|source| PresetError::Fabric { file: file.clone(), source })?;
+    let fabric = if config.physics.compression_buckling {
+        config.fabric.with_compression_buckling(config.mesh.edge_length)
+    } else {
+        config.fabric.clone()
+    };
+    fabric.to_fabric().map_err(|source| PresetError::Fabric { file: file.clone(), source })?;
     check_scene(&config).map_err(|message| PresetError::Invalid { file: file.clone(), message })?;
     Ok((config, file))
 }
