@@ -2,5 +2,6 @@
 //!
 //! `sim` is the physics (no I/O); `scene` turns presets into runnable laboratory tests
 //! with measurements; the `rosette` binary drives scenes from the command line.
+pub mod app;
 pub mod scene;
 pub mod sim;
