@@ -2,6 +2,7 @@
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
+use rosette::app::viewer::ViewerOptions;
 use rosette::scene::{RunOptions, Scene, load_scene, preset, run_scene};
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
@@ -10,7 +11,10 @@ use std::process::ExitCode;
 #[command(name = "rosette", version, about = "Woven-fabric simulator and virtual fabric laboratory")]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
+    /// With no subcommand the viewer opens; exit after drawing N frames (smoke tests).
+    #[arg(long, value_name = "N")]
+    quit_after_frames: Option<u64>,
 }
 
 #[derive(Subcommand)]
@@ -31,6 +35,14 @@ enum Command {
     },
     /// List the bundled scenes.
     Presets,
+    /// Open the interactive viewer (the default when no subcommand is given).
+    View {
+        /// A bundled scene name or scene file (default: the Cusick drape, or Euler buckling).
+        preset: Option<String>,
+        /// Exit after drawing N frames (smoke tests).
+        #[arg(long, value_name = "N")]
+        quit_after_frames: Option<u64>,
+    },
 }
 
 /// Exit codes: 0 done, 2 bad input, 3 the simulation diverged.
@@ -40,13 +52,25 @@ const EXIT_DIVERGED: u8 = 3;
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Presets => {
+        None => view(ViewerOptions { preset: None, quit_after_frames: cli.quit_after_frames }),
+        Some(Command::View { preset, quit_after_frames }) => view(ViewerOptions { preset, quit_after_frames }),
+        Some(Command::Presets) => {
             for (name, description) in preset::scene_descriptions() {
                 println!("{name:<16} {description}");
             }
             ExitCode::SUCCESS
         }
-        Command::Run { preset, overrides, duration, metrics } => run(&preset, &overrides, duration, metrics.as_deref()),
+        Some(Command::Run { preset, overrides, duration, metrics }) => run(&preset, &overrides, duration, metrics.as_deref()),
+    }
+}
+
+fn view(options: ViewerOptions) -> ExitCode {
+    match rosette::app::viewer::run(options) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(EXIT_BAD_INPUT)
+        }
     }
 }
 

@@ -11,3 +11,4 @@ pub mod files;
 pub mod plots;
 pub mod ui;
 pub mod worker;
+pub mod viewer;

@@ -57,8 +57,10 @@ pub struct ViewerUi {
     /// The 3D view's rectangle, in points.
     pub view_rect: Rect,
     pub history: History,
-    /// Messages from the window side (files, dialogs), shown until dismissed.
+    /// Errors from the window side (files, dialogs), shown until dismissed.
     pub messages: Vec<String>,
+    /// The last thing done that has no other feedback (a file saved).
+    pub notice: Option<String>,
     framed_scene: Option<(String, usize)>,
     fabric: Option<FabricConfig>,
     fabric_generation: u64,
@@ -79,6 +81,7 @@ impl Default for ViewerUi {
             view_rect: Rect::NOTHING,
             history: History::default(),
             messages: Vec::new(),
+            notice: None,
             framed_scene: None,
             fabric: None,
             fabric_generation: 0,
@@ -165,7 +168,7 @@ impl ViewerUi {
                 }
             });
             ui.separator();
-            let play = if snapshot.playing { "⏸ Pause" } else { "▶ Play" };
+            let play = if snapshot.playing { "Pause" } else { "Play" };
             if ui.button(play).on_hover_text("Space").clicked() {
                 actions.push(Action::Send(if snapshot.playing { Command::Pause } else { Command::Play }));
             }
@@ -193,18 +196,21 @@ impl ViewerUi {
             if ui.button("Frame").on_hover_text("F: fit the cloth in the view").clicked() {
                 self.camera.frame(&snapshot.positions);
             }
-            if ui.button("📷 PNG").on_hover_text("F12").clicked() {
+            if ui.button("Save PNG").on_hover_text("F12").clicked() {
                 actions.push(Action::Screenshot);
             }
         });
         if let Some(error) = &snapshot.error {
-            ui.colored_label(Color32::from_rgb(255, 110, 100), format!("⚠ {error}"));
+            ui.colored_label(Color32::from_rgb(255, 110, 100), format!("Error: {error}"));
+        }
+        if let Some(notice) = &self.notice {
+            ui.colored_label(Color32::from_rgb(130, 210, 130), notice);
         }
         let mut dismiss = None;
         for (i, message) in self.messages.iter().enumerate() {
             ui.horizontal(|ui| {
-                ui.colored_label(Color32::from_rgb(255, 110, 100), format!("⚠ {message}"));
-                if ui.small_button("✖").clicked() {
+                ui.colored_label(Color32::from_rgb(255, 110, 100), format!("Error: {message}"));
+                if ui.small_button("dismiss").clicked() {
                     dismiss = Some(i);
                 }
             });
