@@ -605,7 +605,8 @@ mod tests {
             let snapshot = worker.sync(Duration::from_secs(60));
             for map in ColourMap::ALL {
                 ui_state.colour_map = map;
-                frame(&ctx, &mut ui_state, &snapshot, Vec::new());
+                let actions = frame(&ctx, &mut ui_state, &snapshot, Vec::new());
+                assert!(actions.is_empty(), "{}: a frame without input asks for nothing: {actions:?}", scene.name);
             }
             assert!(ui_state.view_rect.width() > 100.0, "the 3D view keeps room beside the panels");
         }
