@@ -1,5 +1,5 @@
-//! The strain and bending colour maps: which per-triangle field of a snapshot to show, its
-//! per-vertex values and range, and the colour scale shared by the cloth and the legend.
+//! The strain and bending colour maps: which per-triangle field of a snapshot to show, and
+//! its per-vertex values and range (the renderer draws the scale and its legend).
 
 use super::worker::Snapshot;
 
@@ -51,11 +51,6 @@ impl Field {
     pub fn normalised(&self, value: f32) -> f32 {
         if self.max > self.min { ((value - self.min) / (self.max - self.min)).clamp(0.0, 1.0) } else { 0.5 }
     }
-
-    /// sRGB colour of every vertex.
-    pub fn colours(&self, map: ColourMap) -> Vec<[f32; 3]> {
-        self.values.iter().map(|&v| scale(map, self.normalised(v))).collect()
-    }
 }
 
 /// The per-vertex field of `map` (triangle values averaged onto vertices), or `None` for
@@ -95,31 +90,9 @@ pub fn field(snapshot: &Snapshot, map: ColourMap) -> Option<Field> {
     Some(Field { values, min, max })
 }
 
-/// Colour at position `t` (0..1) of the scale of `map`: blue–white–red for signed fields,
-/// dark blue to yellow for magnitudes. Linear RGB 0..1.
-pub fn scale(map: ColourMap, t: f32) -> [f32; 3] {
-    const DIVERGING: [[f32; 3]; 3] = [[0.23, 0.30, 0.75], [0.87, 0.87, 0.87], [0.71, 0.02, 0.15]];
-    const SEQUENTIAL: [[f32; 3]; 4] = [[0.27, 0.00, 0.33], [0.13, 0.57, 0.55], [0.48, 0.82, 0.32], [0.99, 0.91, 0.14]];
-    let stops: &[[f32; 3]] = if map.signed() { &DIVERGING } else { &SEQUENTIAL };
-    let x = t.clamp(0.0, 1.0) * (stops.len() - 1) as f32;
-    let i = (x.floor() as usize).min(stops.len() - 2);
-    let f = x - i as f32;
-    std::array::from_fn(|c| stops[i][c] + f * (stops[i + 1][c] - stops[i][c]))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn scales_run_end_to_end_and_centre_on_grey() {
-        assert_eq!(scale(ColourMap::WarpStrain, 0.0), [0.23, 0.30, 0.75]);
-        assert_eq!(scale(ColourMap::WarpStrain, 0.5), [0.87, 0.87, 0.87]);
-        let close = |a: [f32; 3], b: [f32; 3]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6);
-        assert!(close(scale(ColourMap::WarpStrain, 1.0), [0.71, 0.02, 0.15]));
-        assert_eq!(scale(ColourMap::Bending, 1.0), [0.99, 0.91, 0.14]);
-        assert_eq!(scale(ColourMap::Bending, 2.0), scale(ColourMap::Bending, 1.0), "clamped");
-    }
 
     #[test]
     fn field_normalises_symmetrically_for_signed_maps() {

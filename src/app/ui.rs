@@ -4,7 +4,7 @@
 //! `egui::Context`.
 
 use super::camera::OrbitCamera;
-use super::colour::{self, ColourMap};
+use super::colour::ColourMap;
 use super::plots::{self, History};
 use super::worker::{Command, Snapshot};
 use crate::scene::preset::{FABRICS, FabricConfig, SCENES, scene_descriptions};
@@ -458,9 +458,6 @@ impl ViewerUi {
                 self.camera.zoom(f64::from(scroll) / 50.0);
             }
         }
-        if let Some(field) = colour::field(snapshot, self.colour_map) {
-            legend(ui, rect, self.colour_map, field.min, field.max);
-        }
     }
 }
 
@@ -472,26 +469,6 @@ fn relative_drag(value: &mut f64) -> egui::DragValue<'_> {
 
 fn curve_mut(fabric: &mut FabricConfig, k: usize) -> &mut Vec<[f64; 2]> {
     if k == 0 { &mut fabric.tensile_warp } else { &mut fabric.tensile_weft }
-}
-
-/// The colour scale bar in the lower right of the view, with its end values.
-fn legend(ui: &egui::Ui, view: Rect, map: ColourMap, min: f32, max: f32) {
-    let painter = ui.painter_at(view);
-    let size = egui::vec2(220.0, 14.0);
-    let bar = Rect::from_min_size(view.max - size - egui::vec2(20.0, 34.0), size);
-    let steps = 32;
-    for i in 0..steps {
-        let t0 = i as f32 / steps as f32;
-        let c = colour::scale(map, t0 + 0.5 / steps as f32);
-        let colour = Color32::from_rgb((c[0] * 255.0) as u8, (c[1] * 255.0) as u8, (c[2] * 255.0) as u8);
-        let x0 = bar.min.x + t0 * bar.width();
-        painter.rect_filled(Rect::from_min_max(egui::pos2(x0, bar.min.y), egui::pos2(x0 + bar.width() / steps as f32 + 0.5, bar.max.y)), 0.0, colour);
-    }
-    let text = Color32::from_gray(230);
-    let font = egui::FontId::proportional(12.0);
-    painter.text(bar.left_bottom() + egui::vec2(0.0, 3.0), egui::Align2::LEFT_TOP, format!("{min:.3e}"), font.clone(), text);
-    painter.text(bar.right_bottom() + egui::vec2(0.0, 3.0), egui::Align2::RIGHT_TOP, format!("{max:.3e}"), font.clone(), text);
-    painter.text(bar.center_top() - egui::vec2(0.0, 3.0), egui::Align2::CENTER_BOTTOM, map.label(), font, text);
 }
 
 /// The warp and weft stress–strain curves as draggable points. Returns whether a curve

@@ -5,7 +5,9 @@
 //! UI over it, draws the cloth into the view rectangle and egui on top. The worker wakes
 //! the event loop when it publishes, so a paused scene costs no frames.
 
+use super::colour::{self, ColourMap};
 use super::files;
+use crate::render::{self, Camera, ColorMap, Frame, PropMesh, RenderOptions, ScalarField};
 use super::ui::{Action, ViewerUi};
 use super::worker::{Command, Snapshot, Worker};
 use crate::scene::load_scene;
@@ -116,6 +118,10 @@ struct Gpu {
     config: wgpu::SurfaceConfiguration,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
+    /// The cloth renderer shared with headless screenshots.
+    scene_renderer: render::Renderer,
+    /// Depth buffer of the window's size, for the cloth pass.
+    depth: Option<(wgpu::TextureView, [u32; 2])>,
 }
 
 struct App {
@@ -218,7 +224,8 @@ impl App {
             Some(device.limits().max_texture_dimension_2d as usize),
         );
         let egui_renderer = egui_wgpu::Renderer::new(&device, config.format, egui_wgpu::RendererOptions::default());
-        Ok(Gpu { window, surface, device, queue, config, egui_state, egui_renderer })
+        let scene_renderer = render::Renderer::new(&device, &queue, config.format, 1);
+        Ok(Gpu { window, surface, device, queue, config, egui_state, egui_renderer, scene_renderer, depth: None })
     }
 
     fn redraw(&mut self, event_loop: &ActiveEventLoop) {
@@ -364,9 +371,6 @@ impl App {
     }
 }
 
-/// Background behind the cloth and the panels (linear RGB).
-const BACKGROUND: wgpu::Color = wgpu::Color { r: 0.10, g: 0.11, b: 0.13, a: 1.0 };
-
 /// Draws one frame (3D view, then egui over it) into `target`.
 fn encode_frame(
     gpu: &mut Gpu,
@@ -395,25 +399,88 @@ fn encode_frame(
     gpu.queue.submit(user_buffers.into_iter().chain(std::iter::once(encoder.finish())));
 }
 
-/// Draws the cloth into the view rectangle of `target` (clearing the whole target first).
+/// The renderer's colour map for the viewer's choice (`None`: the fabric's weave).
+fn render_map(map: ColourMap) -> Option<ColorMap> {
+    match map {
+        ColourMap::Fabric => None,
+        ColourMap::WarpStrain => Some(ColorMap::WarpStrain),
+        ColourMap::WeftStrain => Some(ColorMap::WeftStrain),
+        ColourMap::Shear => Some(ColorMap::Shear),
+        ColourMap::Bending => Some(ColorMap::Bending),
+    }
+}
+
+/// Clears `target` to the background and draws the cloth and props into the view
+/// rectangle left between the panels.
 fn draw_scene(
-    _gpu: &mut Gpu,
+    gpu: &mut Gpu,
     encoder: &mut wgpu::CommandEncoder,
     target: &wgpu::TextureView,
-    _screen: &egui_wgpu::ScreenDescriptor,
-    _snapshot: &Snapshot,
-    _ui: &ViewerUi,
+    screen: &egui_wgpu::ScreenDescriptor,
+    snapshot: &Snapshot,
+    ui: &ViewerUi,
 ) {
-    let _clear = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("clear"),
+    let [width, height] = screen.size_in_pixels;
+    if gpu.depth.as_ref().is_none_or(|(_, size)| *size != [width, height]) {
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("viewer depth"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: render::DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        gpu.depth = Some((texture.create_view(&wgpu::TextureViewDescriptor::default()), [width, height]));
+    }
+    // The view rectangle in pixels, inside the target.
+    let ppp = screen.pixels_per_point;
+    let rect = ui.view_rect;
+    let x0 = (rect.min.x * ppp).round().clamp(0.0, width as f32);
+    let y0 = (rect.min.y * ppp).round().clamp(0.0, height as f32);
+    let x1 = (rect.max.x * ppp).round().clamp(x0, width as f32);
+    let y1 = (rect.max.y * ppp).round().clamp(y0, height as f32);
+    let (view_w, view_h) = ((x1 - x0) as u32, (y1 - y0) as u32);
+    let options = RenderOptions { wireframe: ui.wireframe, ..RenderOptions::default() };
+    let draw = view_w > 0 && view_h > 0 && !snapshot.positions.is_empty();
+    if draw {
+        let mut frame = Frame::from_cloth(&snapshot.positions, &snapshot.triangles, &snapshot.rest, snapshot.config.cloth.warp_angle_deg.to_radians());
+        if let (Some(map), Some(field)) = (render_map(ui.colour_map), colour::field(snapshot, ui.colour_map)) {
+            frame.cloth_scalar = Some(ScalarField { map, values: field.values, min: field.min, max: field.max });
+        }
+        frame.props = snapshot
+            .props
+            .iter()
+            .map(|(p, t)| PropMesh { positions: p.iter().map(|v| v.as_vec3().to_array()).collect(), triangles: t.clone() })
+            .collect();
+        frame.floor_z = snapshot.ground_z.map(|z| z as f32).or_else(|| frame.floor_below());
+        let c = ui.camera;
+        let camera = Camera { target: c.target, yaw: c.yaw, pitch: c.pitch, distance: c.distance, fov_y: c.fov_y };
+        gpu.scene_renderer.prepare(&gpu.device, &gpu.queue, &frame, &camera, &options, [view_w, view_h]);
+    }
+    let [r, g, b] = options.background.map(f64::from);
+    let depth = &gpu.depth.as_ref().expect("made above").0;
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("cloth"),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
             view: target,
             resolve_target: None,
             depth_slice: None,
-            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(BACKGROUND), store: wgpu::StoreOp::Store },
+            // Non-sRGB target: the background's sRGB values are stored as they are.
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }), store: wgpu::StoreOp::Store },
         })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+            stencil_ops: None,
+        }),
         ..Default::default()
     });
+    if draw {
+        pass.set_viewport(x0, y0, view_w as f32, view_h as f32, 0.0, 1.0);
+        gpu.scene_renderer.paint(&mut pass);
+    }
 }
 
 /// Renders the frame again into an offscreen texture, reads it back and writes a PNG.

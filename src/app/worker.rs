@@ -110,6 +110,10 @@ pub struct Snapshot {
     pub rest: Arc<Vec<glam::DVec2>>,
     /// Vertices held by the rig (clamps, grips) or the mouse.
     pub fixed: Vec<bool>,
+    /// Surfaces of the scene's props (ground planes excepted): positions (m) and triangles.
+    pub props: Arc<Vec<(Vec<DVec3>, Vec<[u32; 3]>)>>,
+    /// Height of the highest ground prop, m, if any.
+    pub ground_z: Option<f64>,
     /// Per-triangle membrane strain `[ε_warp, ε_weft, γ]` (empty with the membrane off).
     pub triangle_strains: Vec<[f32; 3]>,
     /// Per-triangle curvature `[κ_warp, κ_weft, κ_twist]`, 1/m (empty with bending off).
@@ -240,6 +244,8 @@ struct WorkerState {
     config: Arc<SceneConfig>,
     triangles: Arc<Vec<[u32; 3]>>,
     rest: Arc<Vec<glam::DVec2>>,
+    props: Arc<Vec<(Vec<DVec3>, Vec<[u32; 3]>)>>,
+    ground_z: Option<f64>,
     mailbox: Arc<Mailbox>,
     on_publish: Option<Box<dyn Fn() + Send>>,
     playing: bool,
@@ -264,6 +270,8 @@ impl WorkerState {
             config: Arc::new(scene.config.clone()),
             triangles: Arc::new(scene.model.triangles.clone()),
             rest: Arc::new(scene.model.rest.clone()),
+            props: Arc::default(),
+            ground_z: None,
             scene,
             scene_name,
             mailbox,
@@ -406,6 +414,10 @@ impl WorkerState {
         self.config = Arc::new(self.scene.config.clone());
         self.triangles = Arc::new(self.scene.model.triangles.clone());
         self.rest = Arc::new(self.scene.model.rest.clone());
+        let (grounds, solids): (Vec<_>, Vec<_>) =
+            self.scene.props.iter().partition(|p| matches!(p.shape, crate::sim::contact::PropShape::Ground));
+        self.ground_z = grounds.iter().map(|p| p.position.z).reduce(f64::max);
+        self.props = Arc::new(solids.iter().map(|p| p.surface_mesh(0.0)).collect());
         self.generation += 1;
         self.finished = false;
         self.error = None;
@@ -542,6 +554,8 @@ impl WorkerState {
             triangles: Arc::clone(&self.triangles),
             rest: Arc::clone(&self.rest),
             fixed: model.fixed.clone(),
+            props: Arc::clone(&self.props),
+            ground_z: self.ground_z,
             triangle_strains: model.triangle_strains(x).into_iter().map(to_f32).collect(),
             triangle_curvatures: model.triangle_curvatures(x).into_iter().map(to_f32).collect(),
             time: self.scene.state.time,
