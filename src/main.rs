@@ -3,6 +3,7 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use rosette::app::viewer::ViewerOptions;
+use rosette::render;
 use rosette::scene::{RunOptions, Scene, load_scene, preset, run_scene};
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
@@ -32,6 +33,8 @@ enum Command {
         /// Write the metrics JSON to FILE, or to standard output with '-'.
         #[arg(long, value_name = "FILE|-")]
         metrics: Option<String>,
+        #[command(flatten)]
+        screenshot: ScreenshotArgs,
     },
     /// List the bundled scenes.
     Presets,
@@ -45,9 +48,32 @@ enum Command {
     },
 }
 
-/// Exit codes: 0 done, 2 bad input, 3 the simulation diverged.
+/// Rendering the final state offscreen (`rosette run ... --screenshot`).
+#[derive(clap::Args)]
+struct ScreenshotArgs {
+    /// Render the final state to this PNG file (offscreen, no display needed).
+    #[arg(long, value_name = "FILE.png")]
+    screenshot: Option<std::path::PathBuf>,
+    /// Image size in pixels.
+    #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = render::Screenshot::parse_size)]
+    size: [u32; 2],
+    /// View direction, yaw and pitch in degrees, and optionally the distance in metres
+    /// (default -60,30, framing the scene).
+    #[arg(long, value_name = "YAW,PITCH[,DISTANCE]", value_parser = render::Screenshot::parse_view, allow_hyphen_values = true)]
+    camera: Option<(f64, f64, Option<f64>)>,
+    /// Colour the cloth by a field: warp, weft, shear or bending.
+    #[arg(long, value_name = "MAP")]
+    colormap: Option<render::ColorMap>,
+    /// Draw the mesh edges over the cloth.
+    #[arg(long)]
+    wireframe: bool,
+}
+
+/// Exit codes: 0 done, 2 bad input, 3 the simulation diverged, 4 the screenshot could not
+/// be rendered or written.
 const EXIT_BAD_INPUT: u8 = 2;
 const EXIT_DIVERGED: u8 = 3;
+const EXIT_NO_SCREENSHOT: u8 = 4;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -60,7 +86,9 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Some(Command::Run { preset, overrides, duration, metrics }) => run(&preset, &overrides, duration, metrics.as_deref()),
+        Some(Command::Run { preset, overrides, duration, metrics, screenshot }) => {
+            run(&preset, &overrides, duration, metrics.as_deref(), &screenshot)
+        }
     }
 }
 
@@ -74,7 +102,7 @@ fn view(options: ViewerOptions) -> ExitCode {
     }
 }
 
-fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Option<&str>) -> ExitCode {
+fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Option<&str>, shot: &ScreenshotArgs) -> ExitCode {
     let config = match load_scene(spec, overrides) {
         Ok((config, _)) => config,
         Err(e) => {
@@ -129,6 +157,14 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Opt
             metrics.steps, metrics.dt, metrics.integrator, metrics.simulated_seconds, metrics.wall_seconds, metrics.cpu_seconds_per_10ms
         );
         println!("{}", serde_json::to_string_pretty(&metrics.measures).expect("JSON values serialise"));
+    }
+    if let Some(path) = &shot.screenshot {
+        // The last good state, also after a divergence.
+        let options = render::Screenshot { path: path.clone(), size: shot.size, view: shot.camera, color_map: shot.colormap, wireframe: shot.wireframe };
+        if let Err(e) = render::save_screenshot(&scene, &options) {
+            eprintln!("error: screenshot: {e}");
+            return ExitCode::from(EXIT_NO_SCREENSHOT);
+        }
     }
     match error {
         Some(e) => {
