@@ -2,6 +2,8 @@
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
+use rosette::app::viewer::ViewerOptions;
+use rosette::render;
 use rosette::scene::{RunOptions, Scene, load_scene, preset, run_scene};
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
@@ -10,7 +12,10 @@ use std::process::ExitCode;
 #[command(name = "rosette", version, about = "Woven-fabric simulator and virtual fabric laboratory")]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
+    /// With no subcommand the viewer opens; exit after drawing N frames (smoke tests).
+    #[arg(long, value_name = "N")]
+    quit_after_frames: Option<u64>,
 }
 
 #[derive(Subcommand)]
@@ -31,31 +36,83 @@ enum Command {
         /// Drape scenes: write the final shadow outline as CSV (angle_deg, radius_m).
         #[arg(long, value_name = "FILE.csv")]
         outline: Option<String>,
+        #[command(flatten)]
+        screenshot: ScreenshotArgs,
     },
     /// List the bundled scenes.
     Presets,
+    /// Open the interactive viewer (the default when no subcommand is given).
+    View {
+        /// A bundled scene name or scene file (default: the Cusick drape, or Euler buckling).
+        preset: Option<String>,
+        /// Exit after drawing N frames (smoke tests).
+        #[arg(long, value_name = "N")]
+        quit_after_frames: Option<u64>,
+    },
 }
 
-/// Exit codes: 0 done, 2 bad input, 3 the simulation diverged.
+/// Rendering the final state offscreen (`rosette run ... --screenshot`).
+#[derive(clap::Args)]
+struct ScreenshotArgs {
+    /// Render the final state to this PNG file (offscreen, no display needed).
+    #[arg(long, value_name = "FILE.png")]
+    screenshot: Option<std::path::PathBuf>,
+    /// Image size in pixels.
+    #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = render::Screenshot::parse_size)]
+    size: [u32; 2],
+    /// View direction, yaw and pitch in degrees, and optionally the distance in metres
+    /// (default -60,30, framing the scene).
+    #[arg(long, value_name = "YAW,PITCH[,DISTANCE]", value_parser = render::Screenshot::parse_view, allow_hyphen_values = true)]
+    camera: Option<(f64, f64, Option<f64>)>,
+    /// Colour the cloth by a field: warp, weft, shear or bending.
+    #[arg(long, value_name = "MAP")]
+    colormap: Option<render::ColorMap>,
+    /// Draw the mesh edges over the cloth.
+    #[arg(long)]
+    wireframe: bool,
+}
+
+/// Exit codes: 0 done, 2 bad input, 3 the simulation diverged, 4 the screenshot could not
+/// be rendered or written.
 const EXIT_BAD_INPUT: u8 = 2;
 const EXIT_DIVERGED: u8 = 3;
+const EXIT_NO_SCREENSHOT: u8 = 4;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Presets => {
+        None => view(ViewerOptions { preset: None, quit_after_frames: cli.quit_after_frames }),
+        Some(Command::View { preset, quit_after_frames }) => view(ViewerOptions { preset, quit_after_frames }),
+        Some(Command::Presets) => {
             for (name, description) in preset::scene_descriptions() {
                 println!("{name:<16} {description}");
             }
             ExitCode::SUCCESS
         }
-        Command::Run { preset, overrides, duration, metrics, outline } => {
-            run(&preset, &overrides, duration, metrics.as_deref(), outline.as_deref())
+        Some(Command::Run { preset, overrides, duration, metrics, outline, screenshot }) => {
+            run(&preset, &overrides, duration, metrics.as_deref(), outline.as_deref(), &screenshot)
         }
     }
 }
 
-fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Option<&str>, outline_out: Option<&str>) -> ExitCode {
+fn view(options: ViewerOptions) -> ExitCode {
+    match rosette::app::viewer::run(options) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(EXIT_BAD_INPUT)
+        }
+    }
+}
+
+fn run(
+    spec: &str,
+    overrides: &[String],
+    duration: Option<f64>,
+    metrics_out: Option<&str>,
+    outline_out: Option<&str>,
+    shot: &ScreenshotArgs,
+) -> ExitCode {
     let config = match load_scene(spec, overrides) {
         Ok((config, _)) => config,
         Err(e) => {
@@ -114,6 +171,14 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, metrics_out: Opt
             metrics.steps, metrics.dt, metrics.integrator, metrics.simulated_seconds, metrics.wall_seconds, metrics.cpu_seconds_per_10ms
         );
         println!("{}", serde_json::to_string_pretty(&metrics.measures).expect("JSON values serialise"));
+    }
+    if let Some(path) = &shot.screenshot {
+        // The last good state, also after a divergence.
+        let options = render::Screenshot { path: path.clone(), size: shot.size, view: shot.camera, color_map: shot.colormap, wireframe: shot.wireframe };
+        if let Err(e) = render::save_screenshot(&scene, &options) {
+            eprintln!("error: screenshot: {e}");
+            return ExitCode::from(EXIT_NO_SCREENSHOT);
+        }
     }
     match error {
         Some(e) => {

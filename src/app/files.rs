@@ -1,0 +1,158 @@
+//! What the viewer reads and writes: scene and fabric TOML, the cloth mesh as OBJ and the
+//! test data as CSV. Plain functions from data to text (the dialogs live in `dialogs`), so
+//! tests check the formats without a window.
+
+use crate::scene::SceneConfig;
+use crate::scene::preset::FabricConfig;
+use glam::{DVec2, DVec3};
+use std::fmt::Write;
+use std::path::Path;
+
+/// A scene as TOML that `rosette run FILE` and the viewer's Open read back.
+pub fn scene_toml(config: &SceneConfig) -> Result<String, String> {
+    toml::to_string_pretty(config).map_err(|e| format!("cannot write the scene as TOML: {e}"))
+}
+
+/// A fabric as TOML, a file that a scene's `fabric.preset` can name. The `preset` key is
+/// left out: every value is written, so the file stands alone.
+pub fn fabric_toml(fabric: &FabricConfig) -> Result<String, String> {
+    let fabric = FabricConfig { preset: None, ..fabric.clone() };
+    toml::to_string_pretty(&fabric).map_err(|e| format!("cannot write the fabric as TOML: {e}"))
+}
+
+/// Reads a fabric file (the format of `presets/fabrics/*.toml`) and checks its values.
+pub fn read_fabric(path: &Path) -> Result<FabricConfig, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let fabric: FabricConfig = toml::from_str(&text).map_err(|e| format!("{}: {}", path.display(), e.message().trim()))?;
+    if fabric.preset.is_some() {
+        return Err(format!(
+            "{}: a fabric file opened in the viewer must give every value itself (remove `preset`)",
+            path.display()
+        ));
+    }
+    fabric.to_fabric().map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(fabric)
+}
+
+/// The cloth as a Wavefront OBJ: positions (m), texture coordinates from the rest
+/// positions (m in the sample plane) and faces.
+pub fn mesh_obj(positions: &[DVec3], rest: &[DVec2], triangles: &[[u32; 3]]) -> String {
+    let mut out = String::from("# Rosette cloth mesh; positions in metres, vt = rest position in the sample plane (m)\n");
+    for p in positions {
+        let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
+    }
+    for r in rest {
+        let _ = writeln!(out, "vt {} {}", r.x, r.y);
+    }
+    for t in triangles {
+        let [a, b, c] = t.map(|v| v + 1);
+        let _ = writeln!(out, "f {a}/{a} {b}/{b} {c}/{c}");
+    }
+    out
+}
+
+/// Column names of the rig's series (see `scene::rigs`), with units.
+fn series_columns(key: &str) -> Option<&'static [&'static str]> {
+    Some(match key {
+        "stress_strain" => &["strain", "stress_N_per_m"],
+        "clamp_stress_strain" => &["clamp_strain", "stress_N_per_m"],
+        "lateral_strain" => &["strain", "lateral_strain"],
+        "lobe_history" => &["time_s", "lobes"],
+        "force_history" => &["time_s", "end_shortening", "end_force_N_per_m", "amplitude_m"],
+        _ => return None,
+    })
+}
+
+/// Test data as CSV: the rig's final scalar measures (`measure,value`), then each of its
+/// series as its own table after a blank line, then the scalar measures sampled over time
+/// while the viewer watched (`history`: time, then `names`).
+pub fn measures_csv(measures: &serde_json::Value, names: &[String], history: &[(f64, Vec<f64>)]) -> String {
+    let mut out = String::from("measure,value\n");
+    let Some(map) = measures.as_object() else { return out };
+    for (key, value) in map {
+        match value {
+            serde_json::Value::Number(n) => {
+                let _ = writeln!(out, "{key},{n}");
+            }
+            serde_json::Value::Bool(b) => {
+                let _ = writeln!(out, "{key},{b}");
+            }
+            _ => {}
+        }
+    }
+    for (key, value) in map {
+        let Some(rows) = value.as_array() else { continue };
+        let rows: Vec<Vec<f64>> =
+            rows.iter().filter_map(|r| r.as_array().map(|r| r.iter().filter_map(serde_json::Value::as_f64).collect())).collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let width = rows.iter().map(Vec::len).max().unwrap_or(0);
+        let header: Vec<String> = match series_columns(key) {
+            Some(columns) if columns.len() == width => columns.iter().map(|c| format!("{key}.{c}")).collect(),
+            _ => (0..width).map(|i| format!("{key}.{i}")).collect(),
+        };
+        let _ = writeln!(out, "\n{}", header.join(","));
+        for row in rows {
+            let _ = writeln!(out, "{}", row.iter().map(f64::to_string).collect::<Vec<_>>().join(","));
+        }
+    }
+    if !history.is_empty() {
+        let _ = writeln!(out, "\ntime_s,{}", names.join(","));
+        for (t, values) in history {
+            let _ = writeln!(out, "{t},{}", values.iter().map(f64::to_string).collect::<Vec<_>>().join(","));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load_scene;
+
+    #[test]
+    fn scene_toml_loads_back_to_the_same_scene() {
+        let (config, _) = load_scene("cantilever", &["fabric.areal_density=0.31".into()]).unwrap();
+        let dir = std::env::temp_dir().join(format!("rosette-files-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("scene.toml");
+        std::fs::write(&path, scene_toml(&config).unwrap()).unwrap();
+        let (back, _) = load_scene(path.to_str().unwrap(), &[]).unwrap();
+        assert_eq!(back.fabric.areal_density, 0.31);
+        assert_eq!(scene_toml(&back).unwrap(), scene_toml(&config).unwrap());
+
+        let fabric_path = dir.join("fabric.toml");
+        std::fs::write(&fabric_path, fabric_toml(&config.fabric).unwrap()).unwrap();
+        let fabric = read_fabric(&fabric_path).unwrap();
+        assert_eq!(fabric.tensile_warp, config.fabric.tensile_warp);
+        assert_eq!(fabric.bending_weft, config.fabric.bending_weft);
+        std::fs::write(&fabric_path, "areal_density = 0.1\n").unwrap();
+        let err = read_fabric(&fabric_path).unwrap_err();
+        assert!(err.contains("thickness") || err.contains("missing"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn obj_has_one_based_faces() {
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let r = [DVec2::ZERO, DVec2::X, DVec2::Y];
+        let obj = mesh_obj(&p, &r, &[[0, 1, 2]]);
+        assert!(obj.contains("\nv 1 0 0\n"));
+        assert!(obj.trim_end().ends_with("f 1/1 2/2 3/3"));
+    }
+
+    #[test]
+    fn csv_has_scalars_series_and_history() {
+        let measures = serde_json::json!({
+            "poisson_ratio": 0.15,
+            "stress_strain": [[0.0, 0.0], [0.01, 2.5]],
+            "strain_definition": "text is left out",
+        });
+        let csv = measures_csv(&measures, &["tip_drop".into()], &[(0.1, vec![0.02])]);
+        assert!(csv.starts_with("measure,value\npoisson_ratio,0.15\n"), "{csv}");
+        assert!(csv.contains("\nstress_strain.strain,stress_strain.stress_N_per_m\n0,0\n0.01,2.5\n"), "{csv}");
+        assert!(csv.contains("\ntime_s,tip_drop\n0.1,0.02\n"), "{csv}");
+        assert!(!csv.contains("text is left out"));
+    }
+}

@@ -1,0 +1,14 @@
+//! The interactive viewer: a winit window with egui panels over the wgpu renderer, driving
+//! a solver that runs on its own thread ([`worker`]).
+//!
+//! - [`worker`]: the solver thread, its commands and snapshots (no GUI dependency).
+//! - [`ui`]: the egui panels and the view's mouse and keys, turned into actions.
+//! - [`camera`]: orbit camera and ray picking; [`colour`]: strain/bending colour maps;
+//!   [`plots`]: live test plots and their references; [`files`]: TOML, OBJ, CSV.
+pub mod camera;
+pub mod colour;
+pub mod files;
+pub mod plots;
+pub mod ui;
+pub mod worker;
+pub mod viewer;

@@ -1,0 +1,547 @@
+//! The window: winit's event loop, the wgpu surface, egui drawn over the 3D view, file
+//! dialogs on their own thread and PNG screenshots read back from the GPU.
+//!
+//! Each frame takes the worker's newest snapshot (never waiting on physics), lays out the
+//! UI over it, draws the cloth into the view rectangle and egui on top. The worker wakes
+//! the event loop when it publishes, so a paused scene costs no frames.
+
+use super::colour::{self, ColourMap};
+use super::files;
+use crate::render::{self, Camera, ColorMap, Frame, PropMesh, RenderOptions, ScalarField};
+use super::ui::{Action, ViewerUi};
+use super::worker::{Command, Snapshot, Worker};
+use crate::scene::load_scene;
+use crate::scene::preset::SCENES;
+use anyhow::{Context, anyhow};
+use egui_wgpu::wgpu;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, Sender, channel};
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, EventLoop, EventLoopProxy};
+use winit::window::{Window, WindowId};
+
+/// How the viewer starts.
+#[derive(Debug, Clone, Default)]
+pub struct ViewerOptions {
+    /// Bundled scene name or scene file; the default scene when `None`.
+    pub preset: Option<String>,
+    /// Exit (status 0) after drawing this many frames: for smoke tests and scripted runs.
+    pub quit_after_frames: Option<u64>,
+}
+
+/// The scene the viewer opens on: the Cusick drape where it exists, else Euler buckling.
+pub fn default_scene() -> &'static str {
+    if SCENES.iter().any(|s| s.name == "cusick-drape") { "cusick-drape" } else { "euler-buckling" }
+}
+
+/// Whether a window can be opened at all (X11 or Wayland).
+pub fn display_available() -> bool {
+    ["DISPLAY", "WAYLAND_DISPLAY"].iter().any(|k| std::env::var_os(k).is_some_and(|v| !v.is_empty()))
+}
+
+/// The message for a machine with no display.
+pub const NO_DISPLAY: &str = "no display: neither DISPLAY nor WAYLAND_DISPLAY is set, so the viewer cannot open a window. \
+     Render a scene headless instead, e.g. `rosette run cantilever --screenshot cantilever.png`, \
+     or start the viewer under a virtual display: `xvfb-run -a rosette view`";
+
+/// Wakes the event loop: a new snapshot or a dialog's answer.
+#[derive(Debug, Clone, Copy)]
+struct Wake;
+
+/// Opens the viewer and runs until its window closes.
+pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
+    if !display_available() {
+        return Err(anyhow!(NO_DISPLAY));
+    }
+    let spec = options.preset.clone().unwrap_or_else(|| default_scene().to_string());
+    let (config, _) = load_scene(&spec, &[]).map_err(|e| anyhow!("{e}"))?;
+    let event_loop = EventLoop::<Wake>::with_user_event()
+        .build()
+        .map_err(|e| anyhow!("cannot connect to the display ({e}). {NO_DISPLAY}"))?;
+    let proxy = event_loop.create_proxy();
+    let wake = proxy.clone();
+    let worker = Worker::spawn(&scene_label(&spec), config, Some(Box::new(move || {
+        let _ = wake.send_event(Wake);
+    })))
+        .map_err(|e| anyhow!("{spec}: {e}"))?;
+    worker.send(Command::Play);
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
+        event_loop.owned_display_handle(),
+    )));
+    let (dialog_tx, dialog_rx) = channel();
+    let mut app = App {
+        options,
+        worker,
+        ui: ViewerUi::default(),
+        egui: egui::Context::default(),
+        instance,
+        gpu: None,
+        frames: 0,
+        fatal: None,
+        proxy,
+        dialog_tx,
+        dialog_rx,
+        dialog_open: false,
+        screenshot: None,
+    };
+    event_loop.run_app(&mut app).context("the window's event loop failed")?;
+    match app.fatal {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// A preset name as typed, or a file's stem.
+fn scene_label(spec: &str) -> String {
+    Path::new(spec).file_stem().map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// What a file dialog was opened for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum DialogKind {
+    OpenScene,
+    SaveScene,
+    OpenFabric,
+    SaveFabric,
+    ExportObj,
+    ExportCsv,
+}
+
+/// GPU state that exists while the window does.
+struct Gpu {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    config: wgpu::SurfaceConfiguration,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    /// The cloth renderer shared with headless screenshots.
+    scene_renderer: render::Renderer,
+    /// Depth buffer of the window's size, for the cloth pass.
+    depth: Option<(wgpu::TextureView, [u32; 2])>,
+}
+
+struct App {
+    options: ViewerOptions,
+    worker: Worker,
+    ui: ViewerUi,
+    egui: egui::Context,
+    instance: wgpu::Instance,
+    gpu: Option<Gpu>,
+    frames: u64,
+    /// An error that ended the viewer (no usable GPU, no window).
+    fatal: Option<anyhow::Error>,
+    proxy: EventLoopProxy<Wake>,
+    dialog_tx: Sender<(DialogKind, Option<PathBuf>)>,
+    dialog_rx: Receiver<(DialogKind, Option<PathBuf>)>,
+    dialog_open: bool,
+    /// Where the next frame is to be saved as PNG.
+    screenshot: Option<PathBuf>,
+}
+
+impl ApplicationHandler<Wake> for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gpu.is_some() {
+            return;
+        }
+        match self.create_gpu(event_loop) {
+            Ok(gpu) => {
+                gpu.window.request_redraw();
+                self.gpu = Some(gpu);
+            }
+            Err(e) => {
+                self.fatal = Some(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn user_event(&mut self, _event_loop: &ActiveEventLoop, _event: Wake) {
+        if let Some(gpu) = &self.gpu {
+            gpu.window.request_redraw();
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(gpu) = &mut self.gpu else { return };
+        let response = gpu.egui_state.on_window_event(&gpu.window, &event);
+        if response.repaint {
+            gpu.window.request_redraw();
+        }
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                gpu.config.width = size.width.max(1);
+                gpu.config.height = size.height.max(1);
+                gpu.surface.configure(&gpu.device, &gpu.config);
+                gpu.window.request_redraw();
+            }
+            WindowEvent::RedrawRequested => self.redraw(event_loop),
+            _ => {}
+        }
+    }
+}
+
+impl App {
+    fn create_gpu(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<Gpu> {
+        let attributes = Window::default_attributes()
+            .with_title("Rosette: woven-fabric simulator")
+            .with_inner_size(winit::dpi::LogicalSize::new(1400.0, 860.0));
+        let window = Arc::new(event_loop.create_window(attributes).context("cannot create the window")?);
+        let surface = self.instance.create_surface(Arc::clone(&window)).context("cannot create a drawing surface for the window")?;
+        let adapter = pollster::block_on(self.instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            compatible_surface: Some(&surface),
+            ..Default::default()
+        }))
+        .context("no graphics adapter can draw to this window (on a machine without a GPU install Mesa: mesa-vulkan-drivers)")?;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("rosette viewer"),
+            required_limits: wgpu::Limits::downlevel_webgl2_defaults().using_resolution(adapter.limits()),
+            ..Default::default()
+        }))
+        .context("cannot open the graphics device")?;
+        let size = window.inner_size();
+        let mut config = surface
+            .get_default_config(&adapter, size.width.max(1), size.height.max(1))
+            .ok_or_else(|| anyhow!("the graphics adapter cannot present to this window"))?;
+        // egui blends in gamma space: prefer a non-sRGB surface format.
+        let capabilities = surface.get_capabilities(&adapter);
+        if let Some(format) = capabilities.formats.iter().find(|f| !f.is_srgb()) {
+            config.format = *format;
+        }
+        config.present_mode = wgpu::PresentMode::AutoVsync;
+        surface.configure(&device, &config);
+        let egui_state = egui_winit::State::new(
+            self.egui.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(device.limits().max_texture_dimension_2d as usize),
+        );
+        let egui_renderer = egui_wgpu::Renderer::new(&device, config.format, egui_wgpu::RendererOptions::default());
+        let scene_renderer = render::Renderer::new(&device, &queue, config.format, 1);
+        Ok(Gpu { window, surface, device, queue, config, egui_state, egui_renderer, scene_renderer, depth: None })
+    }
+
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        self.poll_dialogs();
+        let snapshot = self.worker.latest();
+        let Some(gpu) = &mut self.gpu else { return };
+        let input = gpu.egui_state.take_egui_input(&gpu.window);
+        let ui = &mut self.ui;
+        let mut actions = Vec::new();
+        let output = self.egui.run_ui(input, |root| actions = ui.show(root, &snapshot));
+        gpu.egui_state.handle_platform_output(&gpu.window, output.platform_output);
+        let pixels_per_point = output.pixels_per_point;
+        let jobs = self.egui.tessellate(output.shapes, pixels_per_point);
+        let mut textures = output.textures_delta;
+        for (id, deltas) in &textures.set {
+            for delta in deltas {
+                gpu.egui_renderer.update_texture(&gpu.device, &gpu.queue, *id, delta);
+            }
+        }
+        let frame = match gpu.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(frame) | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => Some(frame),
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                gpu.surface.configure(&gpu.device, &gpu.config);
+                None
+            }
+            _ => None,
+        };
+        let size = [gpu.config.width, gpu.config.height];
+        let screen = egui_wgpu::ScreenDescriptor { size_in_pixels: size, pixels_per_point };
+        if let Some(frame) = frame {
+            let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
+            encode_frame(gpu, &view, &jobs, &screen, &snapshot, ui);
+            gpu.queue.present(frame);
+        }
+        if let Some(path) = self.screenshot.take() {
+            match save_screenshot(gpu, &jobs, &screen, &snapshot, ui, &path) {
+                Ok(()) => ui.notice = Some(format!("saved {}", path.display())),
+                Err(e) => ui.messages.push(format!("screenshot not saved: {e:#}")),
+            }
+        }
+        for id in &textures.free {
+            gpu.egui_renderer.free_texture(id);
+        }
+        textures.clear();
+        let repaint_now = output.viewport_output.get(&egui::ViewportId::ROOT).is_some_and(|v| v.repaint_delay.is_zero());
+        self.frames += 1;
+        if self.options.quit_after_frames.is_some_and(|n| self.frames >= n) {
+            event_loop.exit();
+            return;
+        }
+        if repaint_now || self.options.quit_after_frames.is_some() {
+            gpu.window.request_redraw();
+        }
+        for action in actions {
+            self.act(action, &snapshot);
+        }
+    }
+
+    fn act(&mut self, action: Action, snapshot: &Snapshot) {
+        let dialog = match action {
+            Action::Send(command) => {
+                self.worker.send(command);
+                return;
+            }
+            Action::Screenshot => {
+                let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+                self.screenshot = Some(PathBuf::from(format!("rosette-{}-{stamp}.png", snapshot.scene_name)));
+                if let Some(gpu) = &self.gpu {
+                    gpu.window.request_redraw();
+                }
+                return;
+            }
+            Action::OpenScene => DialogKind::OpenScene,
+            Action::SaveScene => DialogKind::SaveScene,
+            Action::OpenFabric => DialogKind::OpenFabric,
+            Action::SaveFabric => DialogKind::SaveFabric,
+            Action::ExportObj => DialogKind::ExportObj,
+            Action::ExportCsv => DialogKind::ExportCsv,
+        };
+        self.open_dialog(dialog, &snapshot.scene_name);
+    }
+
+    /// Opens a file dialog on its own thread, so the window keeps drawing while it is open.
+    fn open_dialog(&mut self, kind: DialogKind, scene: &str) {
+        if self.dialog_open {
+            return;
+        }
+        self.dialog_open = true;
+        let (tx, proxy) = (self.dialog_tx.clone(), self.proxy.clone());
+        let scene = scene.to_string();
+        let spawned = std::thread::Builder::new().name("rosette-dialog".into()).spawn(move || {
+            let (filter, extension): (&str, &str) = match kind {
+                DialogKind::OpenScene | DialogKind::SaveScene => ("scene", "toml"),
+                DialogKind::OpenFabric | DialogKind::SaveFabric => ("fabric", "toml"),
+                DialogKind::ExportObj => ("Wavefront OBJ", "obj"),
+                DialogKind::ExportCsv => ("CSV", "csv"),
+            };
+            let dialog = rfd::FileDialog::new().add_filter(filter, &[extension]);
+            let path = match kind {
+                DialogKind::OpenScene | DialogKind::OpenFabric => dialog.pick_file(),
+                _ => dialog.set_file_name(format!("{scene}.{extension}")).save_file(),
+            };
+            let _ = tx.send((kind, path));
+            let _ = proxy.send_event(Wake);
+        });
+        if spawned.is_err() {
+            self.dialog_open = false;
+        }
+    }
+
+    /// Carries out the answers of closed file dialogs.
+    fn poll_dialogs(&mut self) {
+        while let Ok((kind, path)) = self.dialog_rx.try_recv() {
+            self.dialog_open = false;
+            let Some(path) = path else { continue };
+            if let Err(e) = self.file_action(kind, &path) {
+                self.ui.messages.push(e);
+            }
+        }
+    }
+
+    fn file_action(&mut self, kind: DialogKind, path: &Path) -> Result<(), String> {
+        let snapshot = self.worker.latest();
+        let write = |text: String| std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()));
+        match kind {
+            DialogKind::OpenScene => {
+                let spec = path.to_string_lossy().into_owned();
+                let (config, _) = load_scene(&spec, &[]).map_err(|e| e.to_string())?;
+                self.worker.send(Command::LoadScene { name: scene_label(&spec), config: Box::new(config) });
+                return Ok(());
+            }
+            DialogKind::SaveScene => write(files::scene_toml(&snapshot.config)?)?,
+            DialogKind::OpenFabric => {
+                self.ui.set_fabric(files::read_fabric(path)?);
+                return Ok(());
+            }
+            DialogKind::SaveFabric => write(files::fabric_toml(&snapshot.config.fabric)?)?,
+            DialogKind::ExportObj => write(files::mesh_obj(&snapshot.positions, &snapshot.rest, &snapshot.triangles))?,
+            DialogKind::ExportCsv => write(files::measures_csv(&snapshot.measures, &self.ui.history.names, &self.ui.history.rows))?,
+        }
+        self.ui.notice = Some(format!("saved {}", path.display()));
+        Ok(())
+    }
+}
+
+/// Draws one frame (3D view, then egui over it) into `target`.
+fn encode_frame(
+    gpu: &mut Gpu,
+    target: &wgpu::TextureView,
+    jobs: &[egui::ClippedPrimitive],
+    screen: &egui_wgpu::ScreenDescriptor,
+    snapshot: &Snapshot,
+    ui: &ViewerUi,
+) {
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer frame") });
+    draw_scene(gpu, &mut encoder, target, screen, snapshot, ui);
+    let user_buffers = gpu.egui_renderer.update_buffers(&gpu.device, &gpu.queue, &mut encoder, jobs, screen);
+    {
+        let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("egui"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                resolve_target: None,
+                depth_slice: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+            })],
+            ..Default::default()
+        });
+        gpu.egui_renderer.render(&mut pass.forget_lifetime(), jobs, screen);
+    }
+    gpu.queue.submit(user_buffers.into_iter().chain(std::iter::once(encoder.finish())));
+}
+
+/// The renderer's colour map for the viewer's choice (`None`: the fabric's weave).
+fn render_map(map: ColourMap) -> Option<ColorMap> {
+    match map {
+        ColourMap::Fabric => None,
+        ColourMap::WarpStrain => Some(ColorMap::WarpStrain),
+        ColourMap::WeftStrain => Some(ColorMap::WeftStrain),
+        ColourMap::Shear => Some(ColorMap::Shear),
+        ColourMap::Bending => Some(ColorMap::Bending),
+    }
+}
+
+/// Clears `target` to the background and draws the cloth and props into the view
+/// rectangle left between the panels.
+fn draw_scene(
+    gpu: &mut Gpu,
+    encoder: &mut wgpu::CommandEncoder,
+    target: &wgpu::TextureView,
+    screen: &egui_wgpu::ScreenDescriptor,
+    snapshot: &Snapshot,
+    ui: &ViewerUi,
+) {
+    let [width, height] = screen.size_in_pixels;
+    if gpu.depth.as_ref().is_none_or(|(_, size)| *size != [width, height]) {
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("viewer depth"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: render::DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        gpu.depth = Some((texture.create_view(&wgpu::TextureViewDescriptor::default()), [width, height]));
+    }
+    // The view rectangle in pixels, inside the target.
+    let ppp = screen.pixels_per_point;
+    let rect = ui.view_rect;
+    let x0 = (rect.min.x * ppp).round().clamp(0.0, width as f32);
+    let y0 = (rect.min.y * ppp).round().clamp(0.0, height as f32);
+    let x1 = (rect.max.x * ppp).round().clamp(x0, width as f32);
+    let y1 = (rect.max.y * ppp).round().clamp(y0, height as f32);
+    let (view_w, view_h) = ((x1 - x0) as u32, (y1 - y0) as u32);
+    let options = RenderOptions { wireframe: ui.wireframe, ..RenderOptions::default() };
+    let draw = view_w > 0 && view_h > 0 && !snapshot.positions.is_empty();
+    if draw {
+        let mut frame = Frame::from_cloth(&snapshot.positions, &snapshot.triangles, &snapshot.rest, snapshot.config.cloth.warp_angle_deg.to_radians());
+        if let (Some(map), Some(field)) = (render_map(ui.colour_map), colour::field(snapshot, ui.colour_map)) {
+            frame.cloth_scalar = Some(ScalarField { map, values: field.values, min: field.min, max: field.max });
+        }
+        frame.props = snapshot
+            .props
+            .iter()
+            .map(|(p, t)| PropMesh { positions: p.iter().map(|v| v.as_vec3().to_array()).collect(), triangles: t.clone() })
+            .collect();
+        frame.floor_z = snapshot.ground_z.map(|z| z as f32).or_else(|| frame.floor_below());
+        let c = ui.camera;
+        let camera = Camera { target: c.target, yaw: c.yaw, pitch: c.pitch, distance: c.distance, fov_y: c.fov_y };
+        gpu.scene_renderer.prepare(&gpu.device, &gpu.queue, &frame, &camera, &options, [view_w, view_h]);
+    }
+    let [r, g, b] = options.background.map(f64::from);
+    let depth = &gpu.depth.as_ref().expect("made above").0;
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("cloth"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            resolve_target: None,
+            depth_slice: None,
+            // Non-sRGB target: the background's sRGB values are stored as they are.
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }), store: wgpu::StoreOp::Store },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+            stencil_ops: None,
+        }),
+        ..Default::default()
+    });
+    if draw {
+        pass.set_viewport(x0, y0, view_w as f32, view_h as f32, 0.0, 1.0);
+        gpu.scene_renderer.paint(&mut pass);
+    }
+}
+
+/// Renders the frame again into an offscreen texture, reads it back and writes a PNG.
+fn save_screenshot(
+    gpu: &mut Gpu,
+    jobs: &[egui::ClippedPrimitive],
+    screen: &egui_wgpu::ScreenDescriptor,
+    snapshot: &Snapshot,
+    ui: &ViewerUi,
+    path: &Path,
+) -> anyhow::Result<()> {
+    let [width, height] = screen.size_in_pixels;
+    let format = gpu.config.format;
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("screenshot"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+    encode_frame(gpu, &view, jobs, screen, snapshot, ui);
+    let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("screenshot readback"),
+        size: u64::from(row) * u64::from(height),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("screenshot copy") });
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(height) },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
+    gpu.queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    let (tx, rx) = channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| drop(tx.send(r)));
+    gpu.device.poll(wgpu::PollType::wait_indefinitely()).context("waiting for the GPU")?;
+    rx.recv().context("the readback was dropped")?.context("cannot map the readback buffer")?;
+    let data = slice.get_mapped_range().context("cannot read the readback buffer")?;
+    let bgra = matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+    let mut rgba = Vec::with_capacity((width * height * 4) as usize);
+    for y in 0..height as usize {
+        for pixel in data[y * row as usize..][..width as usize * 4].chunks_exact(4) {
+            let [a, b, c, alpha] = [pixel[0], pixel[1], pixel[2], pixel[3]];
+            rgba.extend_from_slice(&if bgra { [c, b, a, alpha] } else { [a, b, c, alpha] });
+            let _ = alpha;
+        }
+    }
+    drop(data);
+    buffer.unmap();
+    for alpha in rgba.iter_mut().skip(3).step_by(4) {
+        *alpha = 255;
+    }
+    image::save_buffer(path, &rgba, width, height, image::ExtendedColorType::Rgba8).with_context(|| format!("cannot write {}", path.display()))
+}

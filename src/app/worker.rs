@@ -1,0 +1,579 @@
+//! The simulation worker: a named thread that owns the [`Scene`], takes [`Command`]s from a
+//! channel and publishes the newest [`Snapshot`] into a one-slot mailbox.
+//!
+//! ```text
+//!   UI thread ──Command──▶ mpsc channel ──▶ worker thread (owns Scene, steps at fixed dt)
+//!   UI thread ◀──Arc<Snapshot>── mailbox (Mutex<Option<Arc>>, newest wins) ◀──┘
+//! ```
+//!
+//! The window never waits on physics: it takes whatever snapshot is newest. Physics never
+//! waits on rendering: a snapshot nobody read is simply replaced. The worker steps at the
+//! scene's fixed `solver.dt`; when it is faster than real time it sleeps so that simulated
+//! time follows wall time, and when it is slower it runs flat out and reports the
+//! real-time factor. Nothing here depends on a GUI crate, so tests drive it directly.
+
+use crate::scene::{Scene, SceneConfig, load_scene, preset::FabricConfig};
+use crate::sim::{Integrator, IntegratorKind, State};
+use glam::DVec3;
+use std::collections::VecDeque;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, TryRecvError, channel};
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// What the UI asks of the worker. Commands are handled in the order sent.
+#[derive(Debug, Clone)]
+pub enum Command {
+    /// Builds and shows a new scene (paused at t = 0), labelled `name` (a preset name or a
+    /// file). A scene that fails to build is reported and the current one kept.
+    LoadScene { name: String, config: Box<SceneConfig> },
+    /// Runs the scene, paced to wall time.
+    Play,
+    /// Stops stepping; the state stays.
+    Pause,
+    /// Pauses and advances exactly one step.
+    Step,
+    /// Rebuilds the current scene from its configuration at t = 0, keeping play/pause.
+    Reset,
+    /// Replaces the fabric and restarts the scene from t = 0 (the cloth drapes again with
+    /// the new material), keeping play/pause.
+    SetFabric(Box<FabricConfig>),
+    /// Changes the time step (s) and integrator, keeping the current positions, velocities
+    /// and time. The BDF2 history is dropped: its formula assumes the old step.
+    SetSolver { dt: f64, integrator: IntegratorKind },
+    /// Holds `vertex` at a point moving towards `target` (m) by at most [`DRAG_SPEED`]·dt
+    /// and half an edge per step, so a fast mouse cannot tear the mesh in one step. A second
+    /// drag of another vertex releases the first.
+    DragVertex { vertex: u32, target: DVec3 },
+    /// Lets the dragged vertex go with the velocity it had.
+    ReleaseDrag,
+    /// Loads the bundled laboratory scene `name` with the current fabric and plays it: the
+    /// fabric under design is what the test measures.
+    RunTest(String),
+}
+
+/// Fastest a dragged vertex follows the mouse, m/s.
+pub const DRAG_SPEED: f64 = 1.0;
+
+/// How often a running worker publishes, at most.
+const PUBLISH_INTERVAL: Duration = Duration::from_millis(15);
+
+/// How far simulated time may fall behind wall time before pacing gives up catching up
+/// (the worker then runs flat out and the real-time factor shows the shortfall), s.
+const MAX_LAG: f64 = 0.1;
+
+/// Window over which the rates in [`Stats`] are measured.
+const STATS_WINDOW: Duration = Duration::from_secs(1);
+
+/// Figures for the stats panel.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Stats {
+    pub vertices: usize,
+    pub triangles: usize,
+    /// Steps per wall-clock second over the last second of play.
+    pub steps_per_second: f64,
+    /// Worker CPU time per 10 ms simulated, ms (the unit of the paper's Table 1).
+    pub cpu_ms_per_10ms: f64,
+    /// Simulated seconds per wall-clock second over the last second of play (1 when paced).
+    pub real_time_factor: f64,
+    /// Kinetic energy, J.
+    pub kinetic_energy: f64,
+    /// Membrane (in-plane) elastic energy, J.
+    pub membrane_energy: f64,
+    /// Bending energy, J.
+    pub bending_energy: f64,
+    /// Newton iterations of the last step (0 for the explicit integrator).
+    pub newton_iterations: usize,
+    /// Conjugate-gradient iterations of the last step.
+    pub cg_iterations: usize,
+}
+
+/// What the worker shows the UI: one consistent picture of the simulation.
+#[derive(Debug, Clone)]
+pub struct Snapshot {
+    /// Bumped at each publish.
+    pub serial: u64,
+    /// Number of commands fully handled when this was taken (see [`Worker::send`]).
+    pub commands_done: u64,
+    /// Bumped whenever the scene is rebuilt (the mesh may have changed).
+    pub scene_generation: u64,
+    /// Name of the bundled preset or file the scene came from.
+    pub scene_name: String,
+    /// The configuration of the running scene (fabric and solver as currently set).
+    pub config: Arc<SceneConfig>,
+    /// Vertex positions, m.
+    pub positions: Vec<DVec3>,
+    /// Triangles (counter-clockwise in the rest plane), indices into `positions`.
+    pub triangles: Arc<Vec<[u32; 3]>>,
+    /// Rest positions in the sample plane, m (for texture coordinates).
+    pub rest: Arc<Vec<glam::DVec2>>,
+    /// Vertices held by the rig (clamps, grips) or the mouse.
+    pub fixed: Vec<bool>,
+    /// Surfaces of the scene's props (ground planes excepted): positions (m) and triangles.
+    pub props: Arc<Vec<(Vec<DVec3>, Vec<[u32; 3]>)>>,
+    /// Height of the highest ground prop, m, if any.
+    pub ground_z: Option<f64>,
+    /// Per-triangle membrane strain `[ε_warp, ε_weft, γ]` (empty with the membrane off).
+    pub triangle_strains: Vec<[f32; 3]>,
+    /// Per-triangle curvature `[κ_warp, κ_weft, κ_twist]`, 1/m (empty with bending off).
+    pub triangle_curvatures: Vec<[f32; 3]>,
+    /// Simulated time, s.
+    pub time: f64,
+    /// Steps taken since the scene started.
+    pub steps: u64,
+    /// The scene's `scene.duration`, s.
+    pub duration: f64,
+    pub playing: bool,
+    /// The scene has reached its duration (playing further continues past it).
+    pub finished: bool,
+    pub stats: Stats,
+    /// The rig's measurements (`Scene::measures`), for live plots.
+    pub measures: Arc<serde_json::Value>,
+    /// The last error (a bad scene or fabric, a diverged step), until the next success.
+    pub error: Option<String>,
+    /// The vertex held by the mouse, if any.
+    pub dragged: Option<u32>,
+}
+
+/// The shared one-slot mailbox: the newest snapshot, and a condition variable for callers
+/// that want to wait for one.
+#[derive(Default)]
+struct Mailbox {
+    slot: Mutex<Option<Arc<Snapshot>>>,
+    published: Condvar,
+}
+
+/// Handle to the worker thread. Dropping it stops the thread and joins it.
+pub struct Worker {
+    commands: Option<Sender<Command>>,
+    mailbox: Arc<Mailbox>,
+    sent: AtomicU64,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Worker {
+    /// Builds `config` and starts the worker thread on it, paused. `name` labels the scene.
+    /// `on_publish` is called (on the worker thread) after each publish, e.g. to wake the UI.
+    pub fn spawn(
+        name: &str,
+        config: SceneConfig,
+        on_publish: Option<Box<dyn Fn() + Send>>,
+    ) -> Result<Self, crate::scene::SceneError> {
+        let scene = Scene::build(config)?;
+        let (tx, rx) = channel();
+        let mailbox = Arc::new(Mailbox::default());
+        let mut state = WorkerState::new(name.to_string(), scene, Arc::clone(&mailbox), on_publish);
+        state.publish();
+        let thread = std::thread::Builder::new()
+            .name("rosette-solver".into())
+            .spawn(move || state.run(rx))
+            .expect("the OS can start a thread");
+        Ok(Self { commands: Some(tx), mailbox, sent: AtomicU64::new(0), thread: Some(thread) })
+    }
+
+    /// Queues a command and returns its sequence number: a snapshot with
+    /// `commands_done >= number` reflects it.
+    pub fn send(&self, command: Command) -> u64 {
+        let number = self.sent.fetch_add(1, Ordering::SeqCst) + 1;
+        if let Some(tx) = &self.commands {
+            // The thread only ends when this handle drops, so a failed send means it
+            // panicked; the UI keeps showing the last snapshot.
+            let _ = tx.send(command);
+        }
+        number
+    }
+
+    /// The newest snapshot (never blocks on physics: the lock is held only to swap an Arc).
+    pub fn latest(&self) -> Arc<Snapshot> {
+        self.mailbox.slot.lock().expect("mailbox lock").clone().expect("published at spawn")
+    }
+
+    /// Waits until a snapshot satisfies `ready` or `timeout` passes; returns the newest
+    /// snapshot either way (for tests and scripted use, never the render loop).
+    pub fn wait_for(&self, timeout: Duration, ready: impl Fn(&Snapshot) -> bool) -> Arc<Snapshot> {
+        let deadline = Instant::now() + timeout;
+        let mut slot = self.mailbox.slot.lock().expect("mailbox lock");
+        loop {
+            let snapshot = slot.clone().expect("published at spawn");
+            let now = Instant::now();
+            if ready(&snapshot) || now >= deadline {
+                return snapshot;
+            }
+            slot = self.mailbox.published.wait_timeout(slot, deadline - now).expect("mailbox lock").0;
+        }
+    }
+
+    /// Waits until every command sent so far has been handled.
+    pub fn sync(&self, timeout: Duration) -> Arc<Snapshot> {
+        let sent = self.sent.load(Ordering::SeqCst);
+        self.wait_for(timeout, |s| s.commands_done >= sent)
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        // Closing the channel ends the thread's loop after its current step.
+        self.commands.take();
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+/// A vertex held by the mouse.
+struct Drag {
+    vertex: u32,
+    target: DVec3,
+    /// Where the vertex is held now, m.
+    held_at: DVec3,
+}
+
+/// One step's timing, for the rates in [`Stats`].
+struct StepTiming {
+    start: Instant,
+    end: Instant,
+    simulated: f64,
+    cpu: f64,
+}
+
+/// Everything the worker thread owns.
+struct WorkerState {
+    scene: Scene,
+    scene_name: String,
+    config: Arc<SceneConfig>,
+    triangles: Arc<Vec<[u32; 3]>>,
+    rest: Arc<Vec<glam::DVec2>>,
+    props: Arc<Vec<(Vec<DVec3>, Vec<[u32; 3]>)>>,
+    ground_z: Option<f64>,
+    mailbox: Arc<Mailbox>,
+    on_publish: Option<Box<dyn Fn() + Send>>,
+    playing: bool,
+    finished: bool,
+    error: Option<String>,
+    drag: Option<Drag>,
+    serial: u64,
+    commands_done: u64,
+    generation: u64,
+    /// Pacing anchor: wall time and simulated time when play (re)started.
+    pace: (Instant, f64),
+    timings: VecDeque<StepTiming>,
+    last_report: crate::sim::StepReport,
+    last_publish: Instant,
+    /// Something changed since the last publish.
+    dirty: bool,
+}
+
+impl WorkerState {
+    fn new(scene_name: String, scene: Scene, mailbox: Arc<Mailbox>, on_publish: Option<Box<dyn Fn() + Send>>) -> Self {
+        let mut state = Self {
+            config: Arc::new(scene.config.clone()),
+            triangles: Arc::new(scene.model.triangles.clone()),
+            rest: Arc::new(scene.model.rest.clone()),
+            props: Arc::default(),
+            ground_z: None,
+            scene,
+            scene_name,
+            mailbox,
+            on_publish,
+            playing: false,
+            finished: false,
+            error: None,
+            drag: None,
+            serial: 0,
+            commands_done: 0,
+            generation: 0,
+            pace: (Instant::now(), 0.0),
+            timings: VecDeque::new(),
+            last_report: Default::default(),
+            last_publish: Instant::now(),
+            dirty: true,
+        };
+        state.install_scene_data();
+        state
+    }
+
+    fn run(mut self, commands: Receiver<Command>) {
+        loop {
+            // Wait for a command: indefinitely while paused, until the next step is due
+            // while playing.
+            let first = if !self.playing {
+                match commands.recv() {
+                    Ok(c) => Some(c),
+                    Err(_) => return,
+                }
+            } else {
+                let ahead = self.seconds_ahead();
+                if ahead > 0.0 {
+                    match commands.recv_timeout(Duration::from_secs_f64(ahead)) {
+                        Ok(c) => Some(c),
+                        Err(RecvTimeoutError::Timeout) => None,
+                        Err(RecvTimeoutError::Disconnected) => return,
+                    }
+                } else {
+                    match commands.try_recv() {
+                        Ok(c) => Some(c),
+                        Err(TryRecvError::Empty) => None,
+                        Err(TryRecvError::Disconnected) => return,
+                    }
+                }
+            };
+            if let Some(command) = first {
+                self.handle(command);
+                loop {
+                    match commands.try_recv() {
+                        Ok(c) => self.handle(c),
+                        Err(TryRecvError::Empty) => break,
+                        Err(TryRecvError::Disconnected) => return,
+                    }
+                }
+                // Command results are shown at once, even while playing.
+                self.publish();
+            }
+            if self.playing && self.seconds_ahead() <= 0.0 {
+                self.step_once();
+                if self.scene.state.time >= self.scene.config.scene.duration - 0.5 * self.scene.integrator.dt && !self.finished {
+                    self.finished = true;
+                    self.playing = false;
+                }
+            }
+            if self.dirty && (!self.playing || self.last_publish.elapsed() >= PUBLISH_INTERVAL) {
+                self.publish();
+            }
+        }
+    }
+
+    /// How far simulated time is ahead of wall time since play started, s (negative: behind).
+    /// A lag beyond [`MAX_LAG`] moves the anchor, so a slow solver is not asked to catch up.
+    fn seconds_ahead(&mut self) -> f64 {
+        let (wall, sim) = self.pace;
+        let ahead = (self.scene.state.time - sim) - wall.elapsed().as_secs_f64();
+        if ahead < -MAX_LAG {
+            self.pace = (Instant::now(), self.scene.state.time);
+            return 0.0;
+        }
+        ahead
+    }
+
+    fn handle(&mut self, command: Command) {
+        self.commands_done += 1;
+        self.dirty = true;
+        match command {
+            Command::LoadScene { name, config } => {
+                self.load(*config, Some(name), false).unwrap_or_else(|e| self.error = Some(e));
+            }
+            Command::Play => {
+                self.playing = true;
+                self.pace = (Instant::now(), self.scene.state.time);
+            }
+            Command::Pause => self.playing = false,
+            Command::Step => {
+                self.playing = false;
+                self.step_once();
+            }
+            Command::Reset => {
+                let config = self.scene.config.clone();
+                let playing = self.playing;
+                self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(e));
+            }
+            Command::SetFabric(fabric) => {
+                let mut config = self.scene.config.clone();
+                config.fabric = *fabric;
+                let playing = self.playing;
+                self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(format!("fabric not applied: {e}")));
+            }
+            Command::SetSolver { dt, integrator } => self.set_solver(dt, integrator),
+            Command::DragVertex { vertex, target } => self.drag(vertex, target),
+            Command::ReleaseDrag => self.release_drag(),
+            Command::RunTest(name) => match load_scene(&name, &[]) {
+                Ok((mut config, _)) => {
+                    config.fabric = self.scene.config.fabric.clone();
+                    self.load(config, Some(name), true).unwrap_or_else(|e| self.error = Some(e));
+                }
+                Err(e) => self.error = Some(e.to_string()),
+            },
+        }
+    }
+
+    /// Builds `config` and makes it the running scene, labelled `name` (the old label when
+    /// `None`). On failure the current scene stays and the message is returned.
+    fn load(&mut self, config: SceneConfig, name: Option<String>, play: bool) -> Result<(), String> {
+        let scene = Scene::build(config).map_err(|e| e.to_string())?;
+        self.scene = scene;
+        if let Some(name) = name {
+            self.scene_name = name;
+        }
+        self.install_scene_data();
+        self.playing = play;
+        self.pace = (Instant::now(), 0.0);
+        Ok(())
+    }
+
+    /// Refreshes what snapshots share with the new scene and clears per-scene state.
+    fn install_scene_data(&mut self) {
+        self.config = Arc::new(self.scene.config.clone());
+        self.triangles = Arc::new(self.scene.model.triangles.clone());
+        self.rest = Arc::new(self.scene.model.rest.clone());
+        let (grounds, solids): (Vec<_>, Vec<_>) =
+            self.scene.props.iter().partition(|p| matches!(p.shape, crate::sim::contact::PropShape::Ground));
+        self.ground_z = grounds.iter().map(|p| p.position.z).reduce(f64::max);
+        self.props = Arc::new(solids.iter().map(|p| p.surface_mesh(0.0)).collect());
+        self.generation += 1;
+        self.finished = false;
+        self.error = None;
+        self.drag = None;
+        self.timings.clear();
+        self.last_report = Default::default();
+    }
+
+    fn set_solver(&mut self, dt: f64, integrator: IntegratorKind) {
+        if !(dt.is_finite() && dt > 0.0) {
+            self.error = Some(format!("solver.dt must be a positive number of seconds, got {dt}"));
+            return;
+        }
+        let newton = self.scene.integrator.newton;
+        self.scene.integrator = Integrator::new(integrator, dt);
+        self.scene.integrator.newton = newton;
+        self.scene.config.solver.dt = dt;
+        self.scene.config.solver.integrator = integrator;
+        // A fresh State has no BDF2 history; positions, velocities and time carry over.
+        let old = &self.scene.state;
+        let mut state = State::at_rest(old.x.clone());
+        state.v = old.v.clone();
+        state.time = old.time;
+        state.steps = old.steps;
+        self.scene.state = state;
+        self.config = Arc::new(self.scene.config.clone());
+        self.pace = (Instant::now(), self.scene.state.time);
+        self.timings.clear();
+        self.error = None;
+    }
+
+    fn drag(&mut self, vertex: u32, target: DVec3) {
+        let v = vertex as usize;
+        if v >= self.scene.model.vertex_count() || !target.is_finite() {
+            self.error = Some(format!("cannot drag vertex {vertex}: no such vertex or a non-finite target"));
+            return;
+        }
+        if self.drag.as_ref().is_some_and(|d| d.vertex == vertex) {
+            self.drag.as_mut().expect("checked").target = target;
+            return;
+        }
+        self.release_drag();
+        if self.scene.model.fixed[v] {
+            // Clamped and driven vertices follow their rig; the mouse does not override it.
+            return;
+        }
+        let held_at = self.scene.state.x[v];
+        self.scene.model.pin(vertex, held_at);
+        self.drag = Some(Drag { vertex, target, held_at });
+    }
+
+    fn release_drag(&mut self) {
+        if let Some(drag) = self.drag.take() {
+            self.scene.model.fixed[drag.vertex as usize] = false;
+        }
+    }
+
+    /// Moves the held point of a drag towards its target, at most DRAG_SPEED·dt and half an
+    /// edge per step.
+    fn advance_drag(&mut self) {
+        let Some(drag) = &mut self.drag else { return };
+        let limit = (DRAG_SPEED * self.scene.integrator.dt).min(0.5 * self.scene.model.mean_edge_length);
+        let to_target = drag.target - drag.held_at;
+        let length = to_target.length();
+        drag.held_at += if length > limit { to_target * (limit / length) } else { to_target };
+        self.scene.model.pin(drag.vertex, drag.held_at);
+    }
+
+    fn step_once(&mut self) {
+        self.advance_drag();
+        let start = Instant::now();
+        let cpu = cpu_time::ThreadTime::try_now().ok();
+        let result = self.scene.step();
+        let cpu = cpu.and_then(|c| c.try_elapsed().ok()).map_or(0.0, |d| d.as_secs_f64());
+        self.dirty = true;
+        match result {
+            Ok(report) => {
+                self.last_report = report;
+                self.error = None;
+                let end = Instant::now();
+                self.timings.push_back(StepTiming { start, end, simulated: self.scene.integrator.dt, cpu });
+                while self.timings.front().is_some_and(|t| end.duration_since(t.start) > STATS_WINDOW) && self.timings.len() > 1 {
+                    self.timings.pop_front();
+                }
+            }
+            Err(e) => {
+                // The integrator left the state as it was: keep it and stop.
+                self.error = Some(e.to_string());
+                self.playing = false;
+            }
+        }
+    }
+
+    fn stats(&self) -> Stats {
+        let model = &self.scene.model;
+        let x = &self.scene.state.x;
+        let (membrane_energy, bending_energy) = model.elastic_energy(x);
+        let mut stats = Stats {
+            vertices: model.vertex_count(),
+            triangles: model.triangle_count(),
+            kinetic_energy: self.scene.state.kinetic_energy(model),
+            membrane_energy,
+            bending_energy,
+            newton_iterations: self.last_report.newton_iterations,
+            cg_iterations: self.last_report.cg_iterations,
+            ..Default::default()
+        };
+        if let (Some(first), Some(last)) = (self.timings.front(), self.timings.back()) {
+            let wall = last.end.duration_since(first.start).as_secs_f64();
+            let simulated: f64 = self.timings.iter().map(|t| t.simulated).sum();
+            let cpu: f64 = self.timings.iter().map(|t| t.cpu).sum();
+            if wall > 0.0 && simulated > 0.0 {
+                stats.steps_per_second = self.timings.len() as f64 / wall;
+                stats.real_time_factor = simulated / wall;
+                // CPU s per simulated s, times 10 ms, in ms.
+                stats.cpu_ms_per_10ms = cpu / simulated * 10.0;
+            }
+        }
+        stats
+    }
+
+    fn publish(&mut self) {
+        self.serial += 1;
+        let model = &self.scene.model;
+        let x = &self.scene.state.x;
+        let to_f32 = |v: [f64; 3]| v.map(|c| c as f32);
+        let snapshot = Snapshot {
+            serial: self.serial,
+            commands_done: self.commands_done,
+            scene_generation: self.generation,
+            scene_name: self.scene_name.clone(),
+            config: Arc::clone(&self.config),
+            positions: x.clone(),
+            triangles: Arc::clone(&self.triangles),
+            rest: Arc::clone(&self.rest),
+            fixed: model.fixed.clone(),
+            props: Arc::clone(&self.props),
+            ground_z: self.ground_z,
+            triangle_strains: model.triangle_strains(x).into_iter().map(to_f32).collect(),
+            triangle_curvatures: model.triangle_curvatures(x).into_iter().map(to_f32).collect(),
+            time: self.scene.state.time,
+            steps: self.scene.state.steps,
+            duration: self.scene.config.scene.duration,
+            playing: self.playing,
+            finished: self.finished,
+            stats: self.stats(),
+            measures: Arc::new(self.scene.measures()),
+            error: self.error.clone(),
+            dragged: self.drag.as_ref().map(|d| d.vertex),
+        };
+        *self.mailbox.slot.lock().expect("mailbox lock") = Some(Arc::new(snapshot));
+        self.mailbox.published.notify_all();
+        self.last_publish = Instant::now();
+        self.dirty = false;
+        if let Some(wake) = &self.on_publish {
+            wake();
+        }
+    }
+}

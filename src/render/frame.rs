@@ -1,0 +1,139 @@
+//! The snapshot the renderer draws: plain arrays, no solver types.
+
+use super::colormap::{ColorMap, ScalarField};
+use crate::scene::Scene;
+use crate::sim::contact::props::PropShape;
+use glam::{DVec2, DVec3};
+
+/// Everything one picture needs, in world coordinates (m, z up).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Frame {
+    /// Cloth vertex positions.
+    pub cloth_positions: Vec<[f32; 3]>,
+    /// Cloth triangles; their winding defines the front face (normal = (b−a)×(c−a)).
+    pub cloth_triangles: Vec<[u32; 3]>,
+    /// Per vertex: rest position along the warp and along the weft, m. The weave texture is
+    /// laid along these, so it follows the warp whatever the cut.
+    pub cloth_uv: Vec<[f32; 2]>,
+    /// Colour the cloth by this field instead of its fabric look.
+    pub cloth_scalar: Option<ScalarField>,
+    /// Rigid props (not the ground: that is `floor_z`).
+    pub props: Vec<PropMesh>,
+    /// Height of the floor the shadow falls on, m; no shadow when `None`.
+    pub floor_z: Option<f32>,
+}
+
+/// A prop's surface.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PropMesh {
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Frame {
+    /// A frame of a bare cloth: positions, triangles, and rest positions in the sample
+    /// plane with the warp at `warp_angle` (radians from the rest x axis, as
+    /// `sim::Model::warp_angle`). No props; the floor below the cloth (see
+    /// [`Frame::floor_below`]).
+    pub fn from_cloth(positions: &[DVec3], triangles: &[[u32; 3]], rest: &[DVec2], warp_angle: f64) -> Self {
+        let (c, s) = (warp_angle.cos(), warp_angle.sin());
+        let mut frame = Self {
+            cloth_positions: positions.iter().map(|p| p.as_vec3().to_array()).collect(),
+            cloth_triangles: triangles.to_vec(),
+            // Rest coordinates rotated into the warp/weft frame.
+            cloth_uv: rest.iter().map(|p| [(c * p.x + s * p.y) as f32, (-s * p.x + c * p.y) as f32]).collect(),
+            ..Self::default()
+        };
+        frame.floor_z = frame.floor_below();
+        frame
+    }
+
+    /// The scene's current state. With `color_map`, the cloth is coloured by that field
+    /// (strain or curvature per triangle, averaged onto the vertices). A ground prop
+    /// becomes the floor; without one the floor is put a little below everything.
+    pub fn from_scene(scene: &Scene, color_map: Option<ColorMap>) -> Self {
+        let model = &scene.model;
+        let x = &scene.state.x;
+        let mut frame = Self::from_cloth(x, &model.triangles, &model.rest, model.warp_angle);
+        if let Some(map) = color_map {
+            frame.cloth_scalar = Some(scalar_field(scene, map));
+        }
+        let mut ground: Option<f32> = None;
+        for prop in &scene.props {
+            if matches!(prop.shape, PropShape::Ground) {
+                let z = prop.position.z as f32;
+                ground = Some(ground.map_or(z, |g| g.max(z)));
+                continue;
+            }
+            let (positions, triangles) = prop.surface_mesh(0.0);
+            frame.props.push(PropMesh { positions: positions.iter().map(|p| p.as_vec3().to_array()).collect(), triangles });
+        }
+        frame.floor_z = ground.or_else(|| frame.floor_below());
+        frame
+    }
+
+    /// Axis-aligned bounds of the cloth and the props, or `None` for an empty frame.
+    pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
+        let points = self.cloth_positions.iter().chain(self.props.iter().flat_map(|p| p.positions.iter()));
+        points.filter(|p| p.iter().all(|c| c.is_finite())).fold(None, |acc, p| {
+            let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+            Some(acc.map_or((p, p), |(lo, hi): (DVec3, DVec3)| (lo.min(p), hi.max(p))))
+        })
+    }
+
+    /// The bounds extended down to the floor, so that framing them shows the shadow too.
+    pub fn view_bounds(&self) -> Option<(DVec3, DVec3)> {
+        let (mut lo, hi) = self.bounds()?;
+        if let Some(floor) = self.floor_z {
+            lo.z = lo.z.min(f64::from(floor));
+        }
+        Some((lo, hi))
+    }
+
+    /// A floor a quarter of the scene's size below its lowest point: close enough for the
+    /// shadow to read as contact, far enough to show the cloth's shape.
+    pub fn floor_below(&self) -> Option<f32> {
+        let (lo, hi) = self.bounds()?;
+        let size = (hi - lo).length().max(1e-3);
+        Some((lo.z - 0.25 * size) as f32)
+    }
+}
+
+/// The per-vertex field of `map` for the scene's current state.
+fn scalar_field(scene: &Scene, map: ColorMap) -> ScalarField {
+    let model = &scene.model;
+    let x = &scene.state.x;
+    let per_triangle: Vec<f32> = match map {
+        ColorMap::WarpStrain | ColorMap::WeftStrain | ColorMap::Shear => {
+            let k = match map {
+                ColorMap::WarpStrain => 0,
+                ColorMap::WeftStrain => 1,
+                _ => 2,
+            };
+            model.triangle_strains(x).iter().map(|s| s[k] as f32).collect()
+        }
+        ColorMap::Bending => model
+            .triangle_curvatures(x)
+            .iter()
+            .map(|k| (k[0] * k[0] + k[1] * k[1] + 2.0 * k[2] * k[2]).sqrt() as f32)
+            .collect(),
+    };
+    ScalarField::from_triangles(map, &per_triangle, &model.triangles, x.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uv_follows_the_warp() {
+        let rest = [DVec2::new(0.0, 0.0), DVec2::new(0.01, 0.0), DVec2::new(0.0, 0.01)];
+        let x: Vec<DVec3> = rest.iter().map(|p| p.extend(0.0)).collect();
+        let frame = Frame::from_cloth(&x, &[[0, 1, 2]], &rest, 90f64.to_radians());
+        // With the warp along rest y, a step along rest x is a step against the weft.
+        let close = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).abs() < 1e-7 && (a[1] - b[1]).abs() < 1e-7;
+        assert!(close(frame.cloth_uv[1], [0.0, -0.01]), "{:?}", frame.cloth_uv[1]);
+        assert!(close(frame.cloth_uv[2], [0.01, 0.0]), "{:?}", frame.cloth_uv[2]);
+        assert!(frame.floor_z.unwrap() < 0.0);
+    }
+}

@@ -1,0 +1,128 @@
+//! Rendering: one wgpu renderer for the viewer's window and for headless screenshots, so a
+//! screenshot shows exactly what the viewer shows.
+//!
+//! The renderer sees only a [`Frame`], a plain snapshot of what to draw (cloth positions,
+//! topology, texture coordinates in the warp/weft frame, an optional colour-mapped field,
+//! prop meshes and the floor height), and a [`Camera`]. It knows nothing of the solver.
+//! [`Frame::from_scene`] builds one from a [`Scene`](crate::scene::Scene);
+//! [`Frame::from_cloth`] from bare arrays (the viewer's snapshots).
+//!
+//! # API (kept stable for the viewer)
+//!
+//! ```text
+//! Renderer::new(device: &wgpu::Device, queue: &wgpu::Queue,
+//!               color_format: wgpu::TextureFormat, sample_count: u32) -> Renderer
+//! renderer.prepare(&mut self, device: &wgpu::Device, queue: &wgpu::Queue,
+//!                  frame: &Frame, camera: &Camera, options: &RenderOptions, size: [u32; 2])
+//! renderer.render(&mut self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder,
+//!                 target: &wgpu::TextureView)          // clears, owns depth and MSAA targets
+//! renderer.paint(&self, pass: &mut wgpu::RenderPass<'_>)  // into the caller's pass
+//! Headless::new() -> Result<Headless, RenderError>
+//! headless.render(&mut self, frame: &Frame, camera: &Camera, options: &RenderOptions,
+//!                 size: [u32; 2]) -> Result<image::RgbaImage, RenderError>
+//! save_screenshot(scene: &Scene, options: &Screenshot) -> Result<(), RenderError>
+//! ```
+//!
+//! Each frame: `prepare` uploads the frame's geometry and the camera (it may be skipped when
+//! nothing changed), then either `render` records a pass that clears `target` to
+//! `options.background` and draws everything, or `paint` draws into a pass the caller began.
+//! `target` must be `size` pixels and of the `color_format` given to `new`. For `paint` the
+//! caller's pass needs a depth attachment of [`DEPTH_FORMAT`], cleared to 1.0, and the
+//! `sample_count` given to `new`; the legend is laid out for a viewport of `size` pixels
+//! (call `pass.set_viewport` to place it in part of the window).
+//!
+//! Colour: every colour in this module is sRGB (the values a colour picker shows). On a
+//! non-sRGB target (`Bgra8Unorm`, `Rgba8Unorm`, as egui prefers) the shaders encode
+//! lighting to sRGB themselves; on an `*Srgb` target the hardware does it. Either way the
+//! pixels come out the same.
+//!
+//! What is drawn: the cloth lit from a key light and a sky/ground ambient, two-sided (the
+//! back a lighter tint than the front), textured with a plain weave (`assets/weave.png`,
+//! warp along texture u) at `options.weave_period`; or coloured by a strain or curvature
+//! field on a [`ColorMap`] scale, with a legend bar at the right edge. Props in a neutral
+//! grey. A soft shadow of cloth and props on the floor plane, projected along the light and
+//! blurred with distance from the floor (no floor is drawn: the shadow falls on the
+//! background, like a photographer's shadow catcher). Optionally the mesh edges over the
+//! cloth (the paper's Fig. 6a).
+//!
+//! Shaders are `shaders/scene.wgsl` (cloth, props, shadow) and `shaders/overlay.wgsl`
+//! (legend), bundled with `include_str!`. Nothing here needs more than WebGL2-level limits.
+
+mod camera;
+mod colormap;
+mod font;
+mod frame;
+mod headless;
+mod legend;
+mod renderer;
+
+pub use camera::Camera;
+pub use colormap::{ColorMap, ScalarField};
+pub use frame::{Frame, PropMesh};
+pub use headless::{Headless, Screenshot, save_screenshot};
+pub use legend::bar_rect as legend_bar_rect;
+pub use renderer::{DEPTH_FORMAT, Renderer};
+
+use thiserror::Error;
+
+/// How to draw a frame; everything but the geometry and the camera.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderOptions {
+    /// Draw the mesh edges over the cloth (the paper's Fig. 6a).
+    pub wireframe: bool,
+    /// Draw the colour legend when the frame carries a scalar field.
+    pub legend: bool,
+    /// Draw the soft floor shadow.
+    pub shadow: bool,
+    /// Background, sRGB 0..1.
+    pub background: [f32; 3],
+    /// Front face of the cloth (the side its triangle normals point to), sRGB 0..1.
+    pub front_color: [f32; 3],
+    /// Back face of the cloth, sRGB 0..1.
+    pub back_color: [f32; 3],
+    /// Props, sRGB 0..1.
+    pub prop_color: [f32; 3],
+    /// Wireframe lines, sRGB 0..1.
+    pub wire_color: [f32; 3],
+    /// Length of one repeat of the weave texture along the warp and the weft, m (the
+    /// texture holds four yarns each way, so the yarn spacing is a quarter of this).
+    pub weave_period: f32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            wireframe: false,
+            legend: true,
+            shadow: true,
+            background: BACKGROUND,
+            front_color: [0.72, 0.25, 0.16],
+            back_color: [0.85, 0.55, 0.42],
+            prop_color: [0.62, 0.63, 0.65],
+            wire_color: [0.08, 0.08, 0.10],
+            weave_period: 0.004,
+        }
+    }
+}
+
+/// The default background, sRGB.
+pub const BACKGROUND: [f32; 3] = [0.80, 0.82, 0.85];
+
+/// Why nothing could be rendered.
+#[derive(Debug, Error)]
+pub enum RenderError {
+    #[error(
+        "no graphics adapter found ({0}). On a machine without a GPU install Mesa's software \
+         Vulkan driver (Debian/Ubuntu: `apt-get install mesa-vulkan-drivers`), or set \
+         WGPU_BACKEND=gl with Mesa's EGL (libegl1 libegl-mesa0 libgl1-mesa-dri)"
+    )]
+    NoAdapter(String),
+    #[error("cannot open the graphics device: {0}")]
+    Device(String),
+    #[error("cannot read the image back from the GPU: {0}")]
+    Readback(String),
+    #[error("cannot write {path}: {message}")]
+    Write { path: String, message: String },
+    #[error("{0}")]
+    BadOption(String),
+}

@@ -1,0 +1,610 @@
+//! The wgpu renderer: pipelines, textures, and the per-frame upload of a [`Frame`].
+
+use super::camera::Camera;
+use super::frame::{Frame, PropMesh};
+use super::legend::{self, GRADIENT_ROWS, GRADIENT_TEXELS, OverlayVertex};
+use super::{RenderOptions, font};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+/// Depth buffer format the renderer draws with (the caller's, for [`Renderer::paint`]).
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// The plain-weave texture: one repeat, four yarns each way, warp along u.
+const WEAVE_PNG: &[u8] = include_bytes!("../../assets/weave.png");
+
+/// Where the key light comes from: high, and to the right of the default view, so folds
+/// and buckles are modelled by light and shade.
+const LIGHT_FROM: Vec3 = Vec3::new(0.75, 0.05, 0.7);
+
+/// Where the light that casts the floor shadow comes from: nearly overhead, so the shadow
+/// stays under what casts it.
+const SHADOW_FROM: Vec3 = Vec3::new(0.2, -0.15, 1.0);
+
+/// How much the core of the shadow darkens the background, 0..1.
+const SHADOW_STRENGTH: f32 = 0.32;
+
+/// Penumbra spread per metre of height above the floor (per step of the blur).
+const PENUMBRA: f32 = 0.035;
+
+/// Shadow copies: the core and three rings of eight (`vs_shadow` in `shaders/scene.wgsl`).
+const SHADOW_INSTANCES: u32 = 25;
+
+/// Uniforms, laid out as `Globals` in the shaders.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct Globals {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+    light: [f32; 4],
+    front: [f32; 4],
+    back: [f32; 4],
+    prop: [f32; 4],
+    wire: [f32; 4],
+    background: [f32; 4],
+    shadow: [f32; 4],
+    params: [f32; 4],
+}
+
+/// A vertex of the cloth or a prop (buffers are de-indexed: three per triangle).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct Vertex {
+    position: [f32; 3],
+    normal: [f32; 3],
+    /// Rest position along warp and weft, m.
+    uv: [f32; 2],
+    /// Position on the colour scale 0..1, or −1 for the fabric look.
+    scale: f32,
+}
+
+/// A vertex buffer that grows as needed and is rewritten each frame.
+struct GrowingBuffer {
+    label: &'static str,
+    buffer: Option<wgpu::Buffer>,
+    /// Vertices written by the last upload.
+    count: u32,
+}
+
+impl GrowingBuffer {
+    fn new(label: &'static str) -> Self {
+        Self { label, buffer: None, count: 0 }
+    }
+
+    fn upload<T: Pod>(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, data: &[T]) {
+        self.count = data.len() as u32;
+        if data.is_empty() {
+            return;
+        }
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let size = bytes.len() as u64;
+        if self.buffer.as_ref().is_none_or(|b| b.size() < size) {
+            self.buffer = Some(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(self.label),
+                size: size.next_power_of_two().max(256),
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        queue.write_buffer(self.buffer.as_ref().expect("just made"), 0, bytes);
+    }
+
+    /// The buffer when it holds vertices.
+    fn filled(&self) -> Option<(&wgpu::Buffer, u32)> {
+        self.buffer.as_ref().filter(|_| self.count > 0).map(|b| (b, self.count))
+    }
+}
+
+/// Depth (and multisampled colour) targets for [`Renderer::render`].
+struct Targets {
+    size: [u32; 2],
+    depth: wgpu::TextureView,
+    multisampled: Option<wgpu::TextureView>,
+}
+
+/// Draws [`Frame`]s; see the module documentation for the calling sequence.
+pub struct Renderer {
+    color_format: wgpu::TextureFormat,
+    sample_count: u32,
+    cloth_pipeline: wgpu::RenderPipeline,
+    prop_pipeline: wgpu::RenderPipeline,
+    shadow_pipeline: wgpu::RenderPipeline,
+    overlay_pipeline: wgpu::RenderPipeline,
+    globals: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    cloth: GrowingBuffer,
+    props: GrowingBuffer,
+    overlay: GrowingBuffer,
+    targets: Option<Targets>,
+    /// Of the last `prepare`.
+    size: [u32; 2],
+    background: [f32; 3],
+    shadow: bool,
+}
+
+impl Renderer {
+    /// Pipelines for a `color_format` target drawn at `sample_count` samples per pixel
+    /// (1, or 4 where the adapter supports it for the format and [`DEPTH_FORMAT`]).
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, color_format: wgpu::TextureFormat, sample_count: u32) -> Self {
+        let scene_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("rosette scene shader"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/scene.wgsl").into()),
+        });
+        let overlay_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("rosette overlay shader"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/overlay.wgsl").into()),
+        });
+        let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let sampler_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("rosette globals and textures"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Globals>() as u64),
+                    },
+                    count: None,
+                },
+                texture_entry(1),
+                sampler_entry(2),
+                texture_entry(3),
+                sampler_entry(4),
+                texture_entry(5),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("rosette pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+
+        let vertex_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32];
+        let vertex_layout = wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<Vertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &vertex_attributes,
+        };
+        let multisample = wgpu::MultisampleState { count: sample_count, ..Default::default() };
+        let depth = |write: bool, compare: wgpu::CompareFunction| {
+            Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(write),
+                depth_compare: Some(compare),
+                stencil: wgpu::StencilState::default(),
+                bias: wgpu::DepthBiasState::default(),
+            })
+        };
+        let scene_pipeline = |label: &str, vertex: &str, fragment: &str, blend: Option<wgpu::BlendState>, write_depth: bool| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &scene_shader,
+                    entry_point: Some(vertex),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(vertex_layout.clone())],
+                },
+                // Cloth is two-sided; props are drawn from both sides too, so a mesh with
+                // inconsistent winding still shows.
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil: depth(write_depth, wgpu::CompareFunction::Less),
+                multisample,
+                fragment: Some(wgpu::FragmentState {
+                    module: &scene_shader,
+                    entry_point: Some(fragment),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState { format: color_format, blend, write_mask: wgpu::ColorWrites::ALL })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let cloth_pipeline = scene_pipeline("rosette cloth", "vs_main", "fs_cloth", None, true);
+        let prop_pipeline = scene_pipeline("rosette props", "vs_main", "fs_prop", None, true);
+        // Min blending: where shadow copies overlap, the darkest wins instead of stacking.
+        let min = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Min };
+        let shadow_pipeline = scene_pipeline("rosette shadow", "vs_shadow", "fs_shadow", Some(wgpu::BlendState { color: min, alpha: min }), false);
+
+        let overlay_attributes = wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2, 2 => Float32x4, 3 => Float32];
+        let overlay_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("rosette overlay"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &overlay_shader,
+                entry_point: Some("vs_overlay"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<OverlayVertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &overlay_attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: depth(false, wgpu::CompareFunction::Always),
+            multisample,
+            fragment: Some(wgpu::FragmentState {
+                module: &overlay_shader,
+                entry_point: Some("fs_overlay"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: color_format,
+                    blend: Some(wgpu::BlendState::ALPHA_BLENDING),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+
+        let globals = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("rosette globals"),
+            size: std::mem::size_of::<Globals>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let weave = weave_texture(device, queue);
+        let gradient = device.create_texture_with_data(
+            queue,
+            &texture_descriptor("rosette colour scales", [GRADIENT_TEXELS, GRADIENT_ROWS], 1, wgpu::TextureFormat::Rgba8UnormSrgb),
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &legend::gradient_texels(),
+        );
+        let (font_w, font_h, font_texels) = font::atlas();
+        let font = device.create_texture_with_data(
+            queue,
+            &texture_descriptor("rosette font", [font_w, font_h], 1, wgpu::TextureFormat::R8Unorm),
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &font_texels,
+        );
+        let weave_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("rosette weave sampler"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let gradient_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("rosette gradient sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+        let (weave_view, gradient_view, font_view) = (view(&weave), view(&gradient), view(&font));
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("rosette bind group"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&weave_view) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&weave_sampler) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&gradient_view) },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&gradient_sampler) },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&font_view) },
+            ],
+        });
+        Self {
+            color_format,
+            sample_count,
+            cloth_pipeline,
+            prop_pipeline,
+            shadow_pipeline,
+            overlay_pipeline,
+            globals,
+            bind_group,
+            cloth: GrowingBuffer::new("rosette cloth vertices"),
+            props: GrowingBuffer::new("rosette prop vertices"),
+            overlay: GrowingBuffer::new("rosette overlay vertices"),
+            targets: None,
+            size: [1, 1],
+            background: RenderOptions::default().background,
+            shadow: false,
+        }
+    }
+
+    /// The colour format and sample count given to [`Renderer::new`].
+    pub fn target_format(&self) -> (wgpu::TextureFormat, u32) {
+        (self.color_format, self.sample_count)
+    }
+
+    /// Uploads `frame` seen by `camera` in a view of `size` pixels (width, height).
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &Frame,
+        camera: &Camera,
+        options: &RenderOptions,
+        size: [u32; 2],
+    ) {
+        let size = [size[0].max(1), size[1].max(1)];
+        self.size = size;
+        self.background = options.background;
+        self.shadow = options.shadow && frame.floor_z.is_some();
+        let aspect = f64::from(size[0]) / f64::from(size[1]);
+        let linear = |c: [f32; 3], a: f32| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), a];
+        let light = LIGHT_FROM.normalize();
+        let scalar = frame.cloth_scalar.as_ref();
+        let globals = Globals {
+            view_proj: camera.view_proj(aspect).to_cols_array_2d(),
+            eye: camera.eye().as_vec3().extend(1.0).to_array(),
+            light: light.extend(0.0).to_array(),
+            front: linear(options.front_color, 1.0),
+            back: linear(options.back_color, 1.0),
+            prop: linear(options.prop_color, 1.0),
+            wire: linear(options.wire_color, if options.wireframe { 0.7 } else { 0.0 }),
+            background: linear(options.background, SHADOW_STRENGTH),
+            shadow: (-SHADOW_FROM.normalize()).extend(frame.floor_z.unwrap_or(0.0)).to_array(),
+            params: [
+                1.0 / options.weave_period.max(1e-6),
+                if self.color_format.is_srgb() { 0.0 } else { 1.0 },
+                scalar.map_or(0.5, |s| (s.map.row() as f32 + 0.5) / GRADIENT_ROWS as f32),
+                PENUMBRA,
+            ],
+        };
+        queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
+        self.cloth.upload(device, queue, &cloth_vertices(frame));
+        let props: Vec<Vertex> = frame.props.iter().flat_map(prop_vertices).collect();
+        self.props.upload(device, queue, &props);
+        let overlay = match scalar {
+            Some(field) if options.legend => legend::legend(field, size[0], size[1]),
+            _ => Vec::new(),
+        };
+        self.overlay.upload(device, queue, &overlay);
+        if self.targets.as_ref().is_none_or(|t| t.size != size) {
+            self.targets = Some(self.make_targets(device, size));
+        }
+    }
+
+    fn make_targets(&self, device: &wgpu::Device, size: [u32; 2]) -> Targets {
+        let make = |label, format| {
+            let mut descriptor = texture_descriptor(label, size, 1, format);
+            descriptor.sample_count = self.sample_count;
+            descriptor.usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+            device.create_texture(&descriptor).create_view(&wgpu::TextureViewDescriptor::default())
+        };
+        Targets {
+            size,
+            depth: make("rosette depth", DEPTH_FORMAT),
+            multisampled: (self.sample_count > 1).then(|| make("rosette multisampled colour", self.color_format)),
+        }
+    }
+
+    /// Records a pass that clears `target` (of the prepared size and the renderer's colour
+    /// format) to the background and draws the prepared frame.
+    pub fn render(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView) {
+        let targets = self.targets.as_ref().expect("Renderer::prepare before Renderer::render");
+        let [r, g, b] = if self.color_format.is_srgb() { self.background.map(srgb_to_linear) } else { self.background };
+        let clear = wgpu::Color { r: f64::from(r), g: f64::from(g), b: f64::from(b), a: 1.0 };
+        let (view, resolve_target) = match &targets.multisampled {
+            Some(multisampled) => (multisampled, Some(target)),
+            None => (target, None),
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("rosette scene"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: if resolve_target.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &targets.depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.paint(&mut pass);
+    }
+
+    /// Draws the prepared frame into a pass the caller began (see the module documentation
+    /// for what the pass needs). Opaque geometry first, then the shadow (depth-tested
+    /// against it, so it only shows on the background), then the legend.
+    pub fn paint(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        let meshes = [(&self.cloth_pipeline, self.cloth.filled()), (&self.prop_pipeline, self.props.filled())];
+        for (pipeline, buffer) in meshes {
+            if let Some((buffer, count)) = buffer {
+                pass.set_pipeline(pipeline);
+                pass.set_vertex_buffer(0, buffer.slice(..));
+                pass.draw(0..count, 0..1);
+            }
+        }
+        if self.shadow {
+            pass.set_pipeline(&self.shadow_pipeline);
+            for (buffer, count) in [self.cloth.filled(), self.props.filled()].into_iter().flatten() {
+                pass.set_vertex_buffer(0, buffer.slice(..));
+                pass.draw(0..count, 0..SHADOW_INSTANCES);
+            }
+        }
+        if let Some((buffer, count)) = self.overlay.filled() {
+            pass.set_pipeline(&self.overlay_pipeline);
+            pass.set_vertex_buffer(0, buffer.slice(..));
+            pass.draw(0..count, 0..1);
+        }
+    }
+}
+
+fn texture_descriptor(label: &'static str, [width, height]: [u32; 2], mips: u32, format: wgpu::TextureFormat) -> wgpu::TextureDescriptor<'static> {
+    wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: mips,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    }
+}
+
+/// The weave texture with its mipmap chain (box-filtered in linear light), so the weave
+/// fades to its mean colour instead of shimmering when the cloth is far away.
+fn weave_texture(device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::Texture {
+    let image = image::load_from_memory_with_format(WEAVE_PNG, image::ImageFormat::Png).expect("assets/weave.png is a valid PNG").to_rgba8();
+    let (width, height) = image.dimensions();
+    let mut level: Vec<[f32; 4]> = image.pixels().map(|p| [0, 1, 2, 3].map(|c| if c < 3 { srgb_to_linear(f32::from(p[c]) / 255.0) } else { f32::from(p[c]) / 255.0 })).collect();
+    let (mut w, mut h) = (width as usize, height as usize);
+    let mut data = Vec::new();
+    let mut mips = 0;
+    loop {
+        data.extend(level.iter().flat_map(|p| [0, 1, 2, 3].map(|c| {
+            let v = if c < 3 { linear_to_srgb(p[c]) } else { p[c] };
+            (v * 255.0).round() as u8
+        })));
+        mips += 1;
+        if w == 1 && h == 1 {
+            break;
+        }
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let mut next = vec![[0.0f32; 4]; nw * nh];
+        for y in 0..nh {
+            for x in 0..nw {
+                let mut sum = [0.0f32; 4];
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let p = level[(2 * y + dy).min(h - 1) * w + (2 * x + dx).min(w - 1)];
+                    for c in 0..4 {
+                        sum[c] += 0.25 * p[c];
+                    }
+                }
+                next[y * nw + x] = sum;
+            }
+        }
+        (level, w, h) = (next, nw, nh);
+    }
+    device.create_texture_with_data(
+        queue,
+        &texture_descriptor("rosette weave", [width, height], mips, wgpu::TextureFormat::Rgba8UnormSrgb),
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &data,
+    )
+}
+
+pub(crate) fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+pub(crate) fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// The cloth de-indexed, with smooth (area-weighted) vertex normals and the colour-scale
+/// position of each vertex.
+fn cloth_vertices(frame: &Frame) -> Vec<Vertex> {
+    let positions: Vec<Vec3> = frame.cloth_positions.iter().map(|p| Vec3::from_array(*p)).collect();
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for tri in &frame.cloth_triangles {
+        let [a, b, c] = tri.map(|v| positions[v as usize]);
+        let n = (b - a).cross(c - a);
+        for &v in tri {
+            normals[v as usize] += n;
+        }
+    }
+    let scalar = frame.cloth_scalar.as_ref().filter(|s| s.values.len() == positions.len());
+    let mut vertices = Vec::with_capacity(3 * frame.cloth_triangles.len());
+    for tri in &frame.cloth_triangles {
+        for &v in tri {
+            let v = v as usize;
+            vertices.push(Vertex {
+                position: positions[v].to_array(),
+                normal: normals[v].try_normalize().unwrap_or(Vec3::Z).to_array(),
+                uv: frame.cloth_uv.get(v).copied().unwrap_or_default(),
+                scale: scalar.map_or(-1.0, |s| s.normalised(s.values[v])),
+            });
+        }
+    }
+    vertices
+}
+
+/// A prop de-indexed, each corner's normal averaged over the faces round its vertex that
+/// meet its own face at less than 40°: smooth spheres and cylinder sides, sharp box edges.
+fn prop_vertices(mesh: &PropMesh) -> Vec<Vertex> {
+    let positions: Vec<Vec3> = mesh.positions.iter().map(|p| Vec3::from_array(*p)).collect();
+    let face_normals: Vec<Vec3> = mesh
+        .triangles
+        .iter()
+        .map(|tri| {
+            let [a, b, c] = tri.map(|v| positions[v as usize]);
+            (b - a).cross(c - a)
+        })
+        .collect();
+    let mut faces_of: Vec<Vec<usize>> = vec![Vec::new(); positions.len()];
+    for (f, tri) in mesh.triangles.iter().enumerate() {
+        for &v in tri {
+            faces_of[v as usize].push(f);
+        }
+    }
+    let crease = 40f32.to_radians().cos();
+    let mut vertices = Vec::with_capacity(3 * mesh.triangles.len());
+    for (f, tri) in mesh.triangles.iter().enumerate() {
+        let own = face_normals[f].normalize_or_zero();
+        for &v in tri {
+            let n: Vec3 = faces_of[v as usize]
+                .iter()
+                .map(|&g| face_normals[g])
+                .filter(|n| n.normalize_or_zero().dot(own) >= crease)
+                .sum();
+            vertices.push(Vertex {
+                position: positions[v as usize].to_array(),
+                normal: n.try_normalize().unwrap_or(own).to_array(),
+                uv: [0.0; 2],
+                scale: -1.0,
+            });
+        }
+    }
+    vertices
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_round_trips() {
+        for c in [0.0, 0.002, 0.04, 0.5, 1.0] {
+            assert!((linear_to_srgb(srgb_to_linear(c)) - c).abs() < 1e-5, "{c}");
+        }
+    }
+
+    #[test]
+    fn box_corners_keep_their_face_normals() {
+        // Two faces of a cube meeting at 90° along the edge 0–1.
+        let mesh = PropMesh {
+            positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]],
+            triangles: vec![[0, 1, 2], [1, 0, 3]],
+        };
+        let vertices = prop_vertices(&mesh);
+        assert_eq!(vertices.len(), 6);
+        assert!(vertices[..3].iter().all(|v| v.normal == [0.0, 0.0, 1.0]), "{vertices:?}");
+        assert!(vertices[3..].iter().all(|v| v.normal == [0.0, -1.0, 0.0]), "{vertices:?}");
+    }
+}

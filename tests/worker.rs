@@ -1,0 +1,229 @@
+//! The viewer's solver thread: bit-for-bit determinism against the headless path, and what
+//! each command does to the running scene.
+
+use glam::DVec3;
+use rosette::app::worker::{Command, Snapshot, Worker};
+use rosette::scene::{RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use rosette::sim::IntegratorKind;
+use std::sync::Arc;
+use std::time::Duration;
+
+const WAIT: Duration = Duration::from_secs(120);
+
+fn preset(name: &str) -> SceneConfig {
+    load_scene(name, &[]).unwrap_or_else(|e| panic!("{name}: {e}")).0
+}
+
+fn spawn(name: &str, config: SceneConfig) -> Worker {
+    Worker::spawn(name, config, None).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn bits(x: &[DVec3]) -> Vec<[u64; 3]> {
+    x.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+}
+
+/// The same scene stepped directly with `Scene::step`.
+fn stepped_directly(config: SceneConfig, steps: u64) -> Vec<DVec3> {
+    let mut scene = Scene::build(config).unwrap();
+    for _ in 0..steps {
+        scene.step().unwrap();
+    }
+    scene.state.x
+}
+
+#[test]
+fn worker_steps_match_direct_steps_bit_for_bit() {
+    // Euler buckling starts from a seeded random perturbation and buckles through several
+    // modes: any difference in operation order would show within a few steps.
+    let config = preset("euler-buckling");
+    let n = 60;
+    let worker = spawn("euler-buckling", config.clone());
+    for _ in 0..n {
+        worker.send(Command::Step);
+    }
+    let snapshot = worker.sync(WAIT);
+    assert_eq!(snapshot.steps, n);
+    assert!(snapshot.error.is_none(), "{:?}", snapshot.error);
+    let direct = stepped_directly(config.clone(), n);
+    assert_eq!(bits(&snapshot.positions), bits(&direct), "worker and Scene::step differ");
+
+    // And against the headless runner (`rosette run`) over the same simulated time.
+    let mut scene = Scene::build(config).unwrap();
+    let duration = Some(n as f64 * scene.integrator.dt);
+    let (metrics, error) = run_scene(&mut scene, "euler-buckling", RunOptions { duration, progress: None });
+    assert!(error.is_none());
+    assert_eq!(metrics.steps, n);
+    assert_eq!(bits(&snapshot.positions), bits(&scene.state.x), "worker and run_scene differ");
+}
+
+#[test]
+fn playing_paced_then_paused_matches_direct_steps() {
+    // Free play goes through the paced loop; wherever it stops, the state is the one the
+    // same number of direct steps gives.
+    let config = preset("euler-buckling");
+    let worker = spawn("euler-buckling", config.clone());
+    worker.send(Command::Play);
+    let playing = worker.wait_for(WAIT, |s| s.steps >= 25);
+    assert!(playing.playing);
+    worker.send(Command::Pause);
+    let paused = worker.sync(WAIT);
+    assert!(!paused.playing);
+    let direct = stepped_directly(config, paused.steps);
+    assert_eq!(bits(&paused.positions), bits(&direct));
+    // Paused means no further steps.
+    std::thread::sleep(Duration::from_millis(100));
+    assert_eq!(worker.latest().steps, paused.steps);
+}
+
+#[test]
+fn pacing_follows_wall_time_when_the_solver_is_faster() {
+    // The tensile preset steps at 20 ms and costs well under that: play is paced, so after
+    // about 0.3 s of wall time about 0.3 s is simulated, not the whole 6 s pull.
+    let worker = spawn("tensile-warp", preset("tensile-warp"));
+    worker.send(Command::Play);
+    worker.sync(WAIT);
+    std::thread::sleep(Duration::from_millis(300));
+    let snapshot = worker.latest();
+    assert!(snapshot.time > 0.05 && snapshot.time < 1.5, "simulated {} s in 0.3 s of wall time", snapshot.time);
+    assert!(snapshot.stats.steps_per_second > 0.0);
+}
+
+#[test]
+fn step_and_reset() {
+    let config = preset("cantilever");
+    let dt = config.solver.dt;
+    let worker = spawn("cantilever", config);
+    let start = worker.latest();
+    assert_eq!((start.steps, start.time, start.playing), (0, 0.0, false));
+    assert_eq!(start.positions.len(), start.stats.vertices);
+    assert_eq!(start.triangles.len(), start.stats.triangles);
+    for _ in 0..3 {
+        worker.send(Command::Step);
+    }
+    let stepped = worker.sync(WAIT);
+    assert_eq!(stepped.steps, 3);
+    assert!((stepped.time - 3.0 * dt).abs() < 1e-12);
+    assert_ne!(bits(&stepped.positions), bits(&start.positions), "gravity moved the cloth");
+    worker.send(Command::Reset);
+    let reset = worker.sync(WAIT);
+    assert_eq!((reset.steps, reset.time), (0, 0.0));
+    assert_eq!(bits(&reset.positions), bits(&start.positions));
+    assert!(reset.scene_generation > start.scene_generation);
+}
+
+#[test]
+fn scene_stops_at_its_duration() {
+    let mut config = preset("tensile-warp");
+    config.scene.duration = 5.0 * config.solver.dt;
+    let worker = spawn("tensile-warp", config);
+    worker.send(Command::Play);
+    let done = worker.wait_for(WAIT, |s| s.finished);
+    assert!(done.finished && !done.playing);
+    assert_eq!(done.steps, 5);
+    let stress_strain = done.measures["stress_strain"].as_array().expect("tensile measures");
+    assert!(!stress_strain.is_empty());
+}
+
+#[test]
+fn solver_change_keeps_the_state() {
+    let worker = spawn("cantilever", preset("cantilever"));
+    for _ in 0..4 {
+        worker.send(Command::Step);
+    }
+    let before = worker.sync(WAIT);
+    worker.send(Command::SetSolver { dt: 0.001, integrator: IntegratorKind::Bdf2 });
+    let after = worker.sync(WAIT);
+    assert_eq!(bits(&after.positions), bits(&before.positions));
+    assert_eq!((after.time, after.steps), (before.time, before.steps));
+    assert_eq!(after.config.solver.integrator, IntegratorKind::Bdf2);
+    worker.send(Command::Step);
+    let stepped = worker.sync(WAIT);
+    assert!((stepped.time - before.time - 0.001).abs() < 1e-12);
+    worker.send(Command::SetSolver { dt: -1.0, integrator: IntegratorKind::Bdf2 });
+    assert!(worker.sync(WAIT).error.as_deref().is_some_and(|e| e.contains("solver.dt")));
+}
+
+#[test]
+fn fabric_change_restarts_and_a_bad_fabric_is_reported() {
+    let worker = spawn("cantilever", preset("cantilever"));
+    worker.send(Command::Step);
+    let before = worker.sync(WAIT);
+    let mut fabric = before.config.fabric.clone();
+    fabric.areal_density = -1.0;
+    worker.send(Command::SetFabric(Box::new(fabric.clone())));
+    let rejected = worker.sync(WAIT);
+    let error = rejected.error.clone().expect("a negative density is rejected");
+    assert!(error.contains("areal_density"), "{error}");
+    assert_eq!(rejected.steps, 1, "the running scene is kept");
+    fabric.areal_density = 0.3;
+    worker.send(Command::SetFabric(Box::new(fabric)));
+    let applied = worker.sync(WAIT);
+    assert!(applied.error.is_none());
+    assert_eq!(applied.steps, 0, "the scene restarts with the new fabric");
+    assert_eq!(applied.config.fabric.areal_density, 0.3);
+}
+
+#[test]
+fn run_test_measures_the_current_fabric() {
+    let mut config = preset("cantilever");
+    config.fabric.name = "designer's fabric".into();
+    let worker = spawn("cantilever", config);
+    worker.send(Command::RunTest("tensile-weft".into()));
+    let snapshot = worker.sync(WAIT);
+    assert_eq!(snapshot.scene_name, "tensile-weft");
+    assert!(snapshot.playing);
+    assert_eq!(snapshot.config.fabric.name, "designer's fabric");
+    assert_eq!(snapshot.config.cloth.warp_angle_deg, 90.0, "the test's own geometry");
+    worker.send(Command::RunTest("no-such-test".into()));
+    assert!(worker.sync(WAIT).error.as_deref().is_some_and(|e| e.contains("tensile-warp")), "lists the tests");
+}
+
+#[test]
+fn dragged_vertex_follows_the_target_and_is_released() {
+    let worker = spawn("cantilever", preset("cantilever"));
+    let start = worker.latest();
+    // The free corner farthest from the clamp.
+    let tip = (0..start.positions.len()).max_by(|&a, &b| start.positions[a].x.total_cmp(&start.positions[b].x)).unwrap() as u32;
+    let target = start.positions[tip as usize] + DVec3::new(0.0, 0.0, 0.01);
+    worker.send(Command::DragVertex { vertex: tip, target });
+    for _ in 0..40 {
+        worker.send(Command::Step);
+    }
+    let held = worker.sync(WAIT);
+    assert_eq!(held.dragged, Some(tip));
+    assert!(held.fixed[tip as usize]);
+    assert!((held.positions[tip as usize] - target).length() < 1e-12, "{:?} vs {target:?}", held.positions[tip as usize]);
+    worker.send(Command::ReleaseDrag);
+    for _ in 0..5 {
+        worker.send(Command::Step);
+    }
+    let released = worker.sync(WAIT);
+    assert_eq!(released.dragged, None);
+    assert!(!released.fixed[tip as usize]);
+    assert!(released.positions[tip as usize].z < target.z, "gravity takes it back down");
+    // A clamped vertex is not taken from its clamp.
+    let clamped = start.fixed.iter().position(|&f| f).unwrap() as u32;
+    worker.send(Command::DragVertex { vertex: clamped, target: DVec3::ONE });
+    worker.send(Command::Step);
+    let snapshot = worker.sync(WAIT);
+    assert_eq!(snapshot.dragged, None);
+    assert_eq!(snapshot.positions[clamped as usize], start.positions[clamped as usize]);
+}
+
+#[test]
+fn diverged_step_keeps_the_last_good_state() {
+    let mut config = preset("tensile-warp");
+    config.solver.integrator = IntegratorKind::SymplecticEuler;
+    config.solver.dt = 0.02;
+    let worker = spawn("tensile-warp", config);
+    worker.send(Command::Play);
+    let failed = worker.wait_for(WAIT, |s| s.error.is_some());
+    let error = failed.error.clone().unwrap();
+    assert!(error.contains("diverged"), "{error}");
+    assert!(!failed.playing);
+    assert!(failed.positions.iter().all(|p| p.is_finite()));
+    // The thread keeps serving commands.
+    worker.send(Command::Reset);
+    let reset: Arc<Snapshot> = worker.sync(WAIT);
+    assert_eq!(reset.steps, 0);
+}
