@@ -81,6 +81,21 @@ const EXIT_NO_SCREENSHOT: u8 = 4;
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        None if !rosette::app::viewer::display_available() => {
+            // The main job where no window can open: the default drape, headless, with a
+            // picture of it.
+            eprintln!("no display (DISPLAY and WAYLAND_DISPLAY unset): running cusick-drape headless instead of the viewer");
+            let shot = ScreenshotArgs {
+                screenshot: Some("cusick-drape.png".into()),
+                size: [1280, 800],
+                camera: None,
+                colormap: None,
+                wireframe: false,
+            };
+            let code = run("cusick-drape", &[], None, None, None, &shot);
+            eprintln!("wrote cusick-drape.png; `rosette run PRESET --screenshot FILE.png` for other scenes");
+            code
+        }
         None => view(ViewerOptions { preset: None, quit_after_frames: cli.quit_after_frames }),
         Some(Command::View { preset, quit_after_frames }) => view(ViewerOptions { preset, quit_after_frames }),
         Some(Command::Presets) => {

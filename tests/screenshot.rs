@@ -96,8 +96,10 @@ fn centre_fraction(image: &image::RgbaImage, keep: impl Fn(&image::Rgba<u8>) -> 
 fn check_fabric_picture(name: &str, image: &image::RgbaImage) {
     assert_eq!(image.dimensions(), (SIZE[0], SIZE[1]), "{name}");
     let colours: HashSet<[u8; 3]> = image.pixels().map(|p| [p[0], p[1], p[2]]).collect();
-    // A flat, unlit strip still has its weave, its shading and its shadow's steps.
-    assert!(colours.len() >= 40, "{name}: only {} distinct colours: blank", colours.len());
+    // A blank frame has one colour. A flat strip still has its weave, its shading and its
+    // shadow's steps (105–111 colours at this size); a flat 1 m tablecloth, whose 4 mm weave
+    // averages out at 3 mm a pixel, has 38.
+    assert!(colours.len() >= 20, "{name}: only {} distinct colours: blank", colours.len());
     let cloth = centre_fraction(image, is_cloth);
     assert!(cloth >= 0.25, "{name}: only {:.1} % of the centre is cloth", 100.0 * cloth);
     let bg = background();

@@ -74,18 +74,23 @@ impl Frame {
 
     /// Axis-aligned bounds of the cloth and the props, or `None` for an empty frame.
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
-        let points = self.cloth_positions.iter().chain(self.props.iter().flat_map(|p| p.positions.iter()));
-        points.filter(|p| p.iter().all(|c| c.is_finite())).fold(None, |acc, p| {
-            let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
-            Some(acc.map_or((p, p), |(lo, hi): (DVec3, DVec3)| (lo.min(p), hi.max(p))))
-        })
+        bounds_of(self.cloth_positions.iter().chain(self.props.iter().flat_map(|p| p.positions.iter())))
     }
 
-    /// The bounds extended down to the floor, so that framing them shows the shadow too.
+    /// What a camera should frame: the cloth, and below it the props and the floor down to
+    /// half the cloth's width under its lowest point, so that the shadow shows on a low
+    /// floor while a tall pedestal or table does not shrink the cloth to a sliver.
     pub fn view_bounds(&self) -> Option<(DVec3, DVec3)> {
-        let (mut lo, hi) = self.bounds()?;
+        let Some((cloth_lo, cloth_hi)) = bounds_of(self.cloth_positions.iter()) else { return self.bounds() };
+        let width = (cloth_hi - cloth_lo).truncate().max_element();
+        let reach = cloth_lo.z - 0.5 * width;
+        let (mut lo, mut hi) = (cloth_lo, cloth_hi);
+        if let Some((props_lo, props_hi)) = bounds_of(self.props.iter().flat_map(|p| p.positions.iter())) {
+            lo = lo.min(props_lo.max(DVec3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, reach)));
+            hi = hi.max(props_hi.min(DVec3::new(f64::INFINITY, f64::INFINITY, cloth_hi.z)));
+        }
         if let Some(floor) = self.floor_z {
-            lo.z = lo.z.min(f64::from(floor));
+            lo.z = lo.z.min(f64::from(floor).max(reach));
         }
         Some((lo, hi))
     }
@@ -136,4 +141,12 @@ mod tests {
         assert!(close(frame.cloth_uv[2], [0.01, 0.0]), "{:?}", frame.cloth_uv[2]);
         assert!(frame.floor_z.unwrap() < 0.0);
     }
+}
+
+/// Axis-aligned bounds of the finite points, or `None` when there are none.
+fn bounds_of<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> Option<(DVec3, DVec3)> {
+    points.filter(|p| p.iter().all(|c| c.is_finite())).fold(None, |acc, p| {
+        let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+        Some(acc.map_or((p, p), |(lo, hi): (DVec3, DVec3)| (lo.min(p), hi.max(p))))
+    })
 }
