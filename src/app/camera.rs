@@ -61,22 +61,20 @@ impl OrbitCamera {
         self.distance = 1.15 * radius / (0.5 * self.fov_y).sin();
     }
 
-    /// Eye position, m.
-    pub fn eye(&self) -> DVec3 {
-        self.target + self.distance * self.backward()
+    /// The renderer's camera with this view: the orbit geometry (eye, basis, projection)
+    /// is defined once, in `render::Camera`.
+    pub fn view(&self) -> crate::render::Camera {
+        crate::render::Camera { target: self.target, yaw: self.yaw, pitch: self.pitch, distance: self.distance, fov_y: self.fov_y }
     }
 
-    /// Unit vector from the target to the eye.
-    fn backward(&self) -> DVec3 {
-        DVec3::new(self.pitch.cos() * self.yaw.cos(), self.pitch.cos() * self.yaw.sin(), self.pitch.sin())
+    /// Eye position, m.
+    pub fn eye(&self) -> DVec3 {
+        self.view().eye()
     }
 
     /// Unit forward, right and up vectors of the view.
     pub fn basis(&self) -> (DVec3, DVec3, DVec3) {
-        let forward = -self.backward();
-        let right = forward.cross(DVec3::Z).normalize();
-        let up = right.cross(forward);
-        (forward, right, up)
+        self.view().basis()
     }
 
     /// Turns the camera by a mouse movement of (dx, dy) pixels.

@@ -7,7 +7,7 @@
 
 use super::colour::{self, ColourMap};
 use super::files;
-use crate::render::{self, Camera, ColorMap, Frame, PropMesh, RenderOptions, ScalarField};
+use crate::render::{self, ColorMap, Frame, PropMesh, RenderOptions, ScalarField};
 use super::ui::{Action, ViewerUi};
 use super::worker::{Command, Snapshot, Worker};
 use crate::scene::load_scene;
@@ -455,9 +455,7 @@ fn draw_scene(
             .map(|(p, t)| PropMesh { positions: p.iter().map(|v| v.as_vec3().to_array()).collect(), triangles: t.clone() })
             .collect();
         frame.floor_z = snapshot.ground_z.map(|z| z as f32).or_else(|| frame.floor_below());
-        let c = ui.camera;
-        let camera = Camera { target: c.target, yaw: c.yaw, pitch: c.pitch, distance: c.distance, fov_y: c.fov_y };
-        gpu.scene_renderer.prepare(&gpu.device, &gpu.queue, &frame, &camera, &options, [view_w, view_h]);
+        gpu.scene_renderer.prepare(&gpu.device, &gpu.queue, &frame, &ui.camera.view(), &options, [view_w, view_h]);
     }
     let [r, g, b] = options.background.map(f64::from);
     let depth = &gpu.depth.as_ref().expect("made above").0;
