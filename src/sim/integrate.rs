@@ -217,7 +217,7 @@ impl Integrator {
     /// record.
     fn finish_contact(&mut self, model: &Model, contact: &ContactModel, start: &[DVec3], s: &mut State) {
         if contact.settings.self_collision {
-            self.contact_stats.impacts += contact.stop_self_crossings(start, &mut s.x, &mut s.v, &model.mass, &model.triangles, &model.edges);
+            self.contact_stats.impacts += contact.stop_self_crossings(model, start, &mut s.x, &mut s.v);
         }
         let depth = contact.penetration(&s.x, &model.fixed);
         self.contact_stats.max_penetration = self.contact_stats.max_penetration.max(depth);
@@ -254,7 +254,7 @@ impl Integrator {
                 // The prediction includes gravity's pull over the step, so that contacts a
                 // falling cloth is about to make are there from the first iteration.
                 let predicted: Vec<DVec3> = (0..n).map(|i| inertial[i] + h * h * model.options.gravity).collect();
-                let mut contacts = contact.begin_step(&s.x, &predicted, &model.fixed, &model.mass, &model.triangles, &model.edges, h);
+                let mut contacts = contact.begin_step(model, &s.x, &predicted, h);
                 // Newton's path must start where the cloth is: jumping straight to the
                 // inertial guess could carry a vertex through a layer before any contact
                 // force acts. Start from x_n moved towards the guess as far as no cloth–cloth
@@ -271,7 +271,7 @@ impl Integrator {
                 // Solve; a path that enters a prop without a plane adds one and solves again.
                 for pass in 0..4 {
                     self.newton(&step, Some(&contacts), &mut y, &mut report);
-                    if contact.add_missed(&mut contacts, &s.x, &y, &model.fixed, &model.mass, h) == 0 {
+                    if contact.add_missed(&mut contacts, model, &s.x, &y, h) == 0 {
                         break;
                     }
                     self.contact_stats.resolves += 1;

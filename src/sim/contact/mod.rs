@@ -34,6 +34,7 @@ pub mod props;
 
 pub use props::{Prop, PropError, PropShape, SurfacePoint};
 
+use crate::sim::model::Model;
 use crate::sim::sparse::{BlockCsr, Coupling};
 use geometry::{SpatialHash, closest_point_triangle, closest_points_segments, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
 use glam::{DMat3, DVec3};
@@ -175,17 +176,8 @@ impl ContactModel {
 
     /// The contacts for a step from `start` (positions x_n) towards `predicted` (x_n + h v_n
     /// or the BDF2 equivalent), with time step `h` and vertex masses.
-    #[allow(clippy::too_many_arguments)]
-    pub fn begin_step(
-        &self,
-        start: &[DVec3],
-        predicted: &[DVec3],
-        fixed: &[bool],
-        mass: &[f64],
-        triangles: &[[u32; 3]],
-        edges: &[[u32; 2]],
-        h: f64,
-    ) -> StepContacts {
+    pub fn begin_step(&self, model: &Model, start: &[DVec3], predicted: &[DVec3], h: f64) -> StepContacts {
+        let (fixed, mass) = (&model.fixed, &model.mass);
         let s = &self.settings;
         let mut contacts = StepContacts {
             planes: Vec::new(),
@@ -202,7 +194,7 @@ impl ContactModel {
             }
         }
         if s.self_collision {
-            contacts.pairs = self.self_pairs(start, predicted, fixed, mass, triangles, edges, h);
+            contacts.pairs = self.self_pairs(model, start, predicted, h);
         }
         contacts
     }
@@ -240,7 +232,8 @@ impl ContactModel {
 
     /// After a solve from `start` to `end`: adds planes for paths that enter a prop without
     /// one. Returns how many were added (zero: the step stands).
-    pub fn add_missed(&self, contacts: &mut StepContacts, start: &[DVec3], end: &[DVec3], fixed: &[bool], mass: &[f64], h: f64) -> usize {
+    pub fn add_missed(&self, contacts: &mut StepContacts, model: &Model, start: &[DVec3], end: &[DVec3], h: f64) -> usize {
+        let (fixed, mass) = (&model.fixed, &model.mass);
         let mut added = 0;
         for v in 0..start.len() {
             if fixed[v] {
@@ -320,17 +313,8 @@ impl ContactModel {
     }
 
     /// Vertex–triangle pairs within reach over the step.
-    #[allow(clippy::too_many_arguments)]
-    fn self_pairs(
-        &self,
-        start: &[DVec3],
-        predicted: &[DVec3],
-        fixed: &[bool],
-        mass: &[f64],
-        triangles: &[[u32; 3]],
-        edges: &[[u32; 2]],
-        h: f64,
-    ) -> Vec<SelfPair> {
+    fn self_pairs(&self, model: &Model, start: &[DVec3], predicted: &[DVec3], h: f64) -> Vec<SelfPair> {
+        let (fixed, mass, triangles, edges) = (&model.fixed, &model.mass, &model.triangles, &model.edges);
         let delta = self.settings.self_thickness;
         let motion = |v: usize| (predicted[v] - start[v]).length();
         let cell = mean_edge(start, triangles).max(2.0 * delta);
@@ -405,7 +389,8 @@ impl ContactModel {
     /// The continuous-collision fail-safe: finds vertex–triangle and edge–edge pairs that
     /// cross between `start` and `end`, holds their vertices at `start` and gives each
     /// impact zone its mean velocity. Returns the number of crossings stopped.
-    pub fn stop_self_crossings(&self, start: &[DVec3], end: &mut [DVec3], v: &mut [DVec3], mass: &[f64], triangles: &[[u32; 3]], edges: &[[u32; 2]]) -> u64 {
+    pub fn stop_self_crossings(&self, model: &Model, start: &[DVec3], end: &mut [DVec3], v: &mut [DVec3]) -> u64 {
+        let (mass, triangles, edges) = (&model.mass, &model.triangles, &model.edges);
         let n = start.len();
         let eps = 1e-3 * self.settings.self_thickness;
         let mut zone: Vec<u32> = (0..n as u32).collect();
