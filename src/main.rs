@@ -41,6 +41,19 @@ enum Command {
     },
     /// List the bundled scenes.
     Presets,
+    /// Time the paper's Table 1 scenes and the Cusick drape at about 800, 5 000, 20 000
+    /// and 80 000 triangles, on 1 and 2 threads; writes bench.csv and bench.json.
+    Bench {
+        /// Directory for bench.csv and bench.json.
+        #[arg(long, default_value = "bench")]
+        out: std::path::PathBuf,
+        /// Short windows and the two smaller drapes only (about a minute).
+        #[arg(long)]
+        quick: bool,
+        /// Thread counts to run each case with.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+    },
     /// Open the interactive viewer (the default when no subcommand is given).
     View {
         /// A bundled scene name or scene file (default: the Cusick drape, or Euler buckling).
@@ -104,6 +117,13 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Some(Command::Bench { out, quick, threads }) => match rosette::bench::run(&out, quick, &threads) {
+            Ok(_) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e:#}");
+                ExitCode::from(EXIT_BAD_INPUT)
+            }
+        },
         Some(Command::Run { preset, overrides, duration, metrics, outline, screenshot }) => {
             run(&preset, &overrides, duration, metrics.as_deref(), outline.as_deref(), &screenshot)
         }

@@ -20,10 +20,10 @@ fn drape_coefficient(m: &Metrics) -> f64 {
     m.measures["drape_coefficient"].as_f64().unwrap()
 }
 
-/// Runs `cusick-drape` for several override sets on both cores.
-fn run_all(sets: Vec<Vec<String>>) -> Vec<(SceneConfig, Metrics)> {
+/// Runs `preset` for several override sets on both cores.
+fn run_all(preset: &str, sets: Vec<Vec<String>>) -> Vec<(SceneConfig, Metrics)> {
     std::thread::scope(|s| {
-        let handles: Vec<_> = sets.iter().map(|o| s.spawn(move || run("cusick-drape", o))).collect();
+        let handles: Vec<_> = sets.iter().map(|o| s.spawn(move || run(preset, o))).collect();
         handles.into_iter().map(|h| h.join().unwrap()).collect()
     })
 }
@@ -45,7 +45,7 @@ const MEASURED: [(&str, f64, f64); 5] =
 /// independent radial strips could (the strip bound of REFERENCE §7).
 #[test]
 fn every_fabric_settles_into_clean_folds_above_the_strip_bound() {
-    let results = run_all(MEASURED.iter().map(|(f, _, _)| vec![format!("fabric.preset={f}")]).collect());
+    let results = run_all("cusick-drape", MEASURED.iter().map(|(f, _, _)| vec![format!("fabric.preset={f}")]).collect());
     for ((fabric, _, _), (config, m)) in MEASURED.iter().zip(&results) {
         let dc = drape_coefficient(m);
         let nodes = m.measures["nodes"].as_u64().unwrap();
@@ -74,19 +74,20 @@ fn strip_bound(config: &SceneConfig) -> f64 {
     independent_strip_drape_lower_bound(config.cloth.diameter, 0.18, f.areal_density, b_min, 9.81)
 }
 
-/// Measured ranges and the bending-length order. This fails today: with sub-element
-/// buckling at 875 triangles silk (0.315), polyester (0.355) and the cotton shirting
-/// (0.414) fall in their ranges, but wool (0.344) drapes below the 0.4–0.7 of light wools,
-/// below polyester although its bending length is 17 % longer, and denim (0.43) far below
-/// 0.7–0.9. See the README's drape section.
+/// Measured ranges and the bending-length order, on the standard's 30 cm specimen: the
+/// classes of REFERENCE §7 are what the standard test (BS 5058) measures, and the drape
+/// coefficient depends on the specimen's size (Cusick keeps the 36 cm disc of the paper's
+/// scene for fabrics too limp to measure on 30 cm). On the 36 cm disc the same fabrics give
+/// 0.31–0.43 (README, Drape).
 #[test]
-#[ignore = "wool 0.344 < 0.4 and below polyester 0.355; denim 0.43 < 0.7 (README, Drape)"]
 fn each_fabric_drapes_within_its_measured_range_in_bending_length_order() {
-    let results = run_all(MEASURED.iter().map(|(f, _, _)| vec![format!("fabric.preset={f}")]).collect());
+    let results =
+        run_all("cusick-drape-30", MEASURED.iter().map(|(f, _, _)| vec![format!("fabric.preset={f}")]).collect());
     let mut by_length = Vec::new();
     for ((fabric, lo, hi), (config, m)) in MEASURED.iter().zip(&results) {
         let dc = drape_coefficient(m);
-        println!("{fabric}: DC {dc:.3}");
+        println!("{fabric}: DC {dc:.3}, strip bound {:.3}", strip_bound(config));
+        assert!(dc > strip_bound(config), "{fabric}: DC {dc:.3} below the strip bound");
         assert!((*lo..=*hi).contains(&dc), "{fabric}: DC {dc:.3} outside the measured {lo}–{hi}");
         by_length.push((bending_length(config), dc, *fabric));
     }
@@ -106,7 +107,7 @@ fn each_fabric_drapes_within_its_measured_range_in_bending_length_order() {
 #[test]
 fn drape_coefficient_is_mesh_independent() {
     // Edge lengths 15.5 mm (about 800 triangles, the paper's) and 10.3 mm (a factor 1.5).
-    let results = run_all(vec![vec!["mesh.edge_length=0.0155".into()], vec!["mesh.edge_length=0.0103".into()]]);
+    let results = run_all("cusick-drape", vec![vec!["mesh.edge_length=0.0155".into()], vec!["mesh.edge_length=0.0103".into()]]);
     let (coarse, fine) = (drape_coefficient(&results[0].1), drape_coefficient(&results[1].1));
     println!("DC {coarse:.3} ({} triangles), {fine:.3} ({} triangles)", results[0].1.triangles, results[1].1.triangles);
     assert!((coarse - fine).abs() < 0.03, "DC {coarse:.3} vs {fine:.3}");
@@ -114,7 +115,7 @@ fn drape_coefficient_is_mesh_independent() {
 
 #[test]
 fn random_starts_scatter_the_coefficient_by_a_few_hundredths() {
-    let results = run_all((1..=3).map(|seed| vec![format!("scene.seed={seed}")]).collect());
+    let results = run_all("cusick-drape", (1..=3).map(|seed| vec![format!("scene.seed={seed}")]).collect());
     let dcs: Vec<f64> = results.iter().map(|r| drape_coefficient(&r.1)).collect();
     let nodes: Vec<u64> = results.iter().map(|r| r.1.measures["nodes"].as_u64().unwrap()).collect();
     println!("DC {dcs:?}, nodes {nodes:?}");

@@ -332,7 +332,7 @@ impl WorkerState {
             }
             if self.playing && self.seconds_ahead() <= 0.0 {
                 self.step_once();
-                if self.scene.state.time >= self.scene.config.scene.duration - 0.5 * self.scene.integrator.dt && !self.finished {
+                if self.scene.state.time >= self.scene.config.scene.duration - 1e-6 * self.scene.integrator.dt && !self.finished {
                     self.finished = true;
                     self.playing = false;
                 }
@@ -498,7 +498,7 @@ impl WorkerState {
                 self.last_report = report;
                 self.error = None;
                 let end = Instant::now();
-                self.timings.push_back(StepTiming { start, end, simulated: self.scene.integrator.dt, cpu });
+                self.timings.push_back(StepTiming { start, end, simulated: report.dt, cpu });
                 while self.timings.front().is_some_and(|t| end.duration_since(t.start) > STATS_WINDOW) && self.timings.len() > 1 {
                     self.timings.pop_front();
                 }

@@ -94,6 +94,7 @@ impl Scene {
         }
         let mut integrator = Integrator::new(config.solver.integrator, config.solver.dt);
         integrator.newton = config.solver.newton;
+        integrator.adaptive = config.solver.adaptive;
         let steps = (config.scene.duration / config.solver.dt).ceil().max(1.0) as u64;
         let sample_every = (steps / 400).max(1);
         Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every })

@@ -6,7 +6,7 @@
 //! fabric file. Overrides given with `--set KEY=VALUE` are applied to the scene before the
 //! fabric is merged, so they win over both. Unknown keys are errors, so a typo fails loudly.
 
-use crate::sim::{Fabric, FabricError, IntegratorKind, NewtonSettings, Pattern, PiecewiseLinear};
+use crate::sim::{AdaptiveStep, Fabric, FabricError, IntegratorKind, NewtonSettings, Pattern, PiecewiseLinear};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -293,6 +293,9 @@ pub struct SolverSection {
     pub damping: f64,
     #[serde(default)]
     pub newton: NewtonSettings,
+    /// Adaptive time steps (implicit integrators), starting from `dt`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<AdaptiveStep>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -500,6 +503,23 @@ fn check_scene(c: &SceneConfig) -> Result<(), String> {
     positive("mesh.edge_length", c.mesh.edge_length)?;
     if !(c.solver.damping >= 0.0 && c.solver.damping.is_finite()) {
         return Err(format!("solver.damping must be zero or positive (1/s), got {}", c.solver.damping));
+    }
+    if let Some(a) = c.solver.adaptive.filter(|a| a.enabled) {
+        positive("solver.adaptive.tolerance", a.tolerance)?;
+        positive("solver.adaptive.dt_min", a.dt_min)?;
+        if !(a.dt_min <= c.solver.dt && c.solver.dt <= a.dt_max) {
+            return Err(format!(
+                "solver.dt = {} s must lie between solver.adaptive.dt_min = {} s and dt_max = {} s",
+                c.solver.dt, a.dt_min, a.dt_max
+            ));
+        }
+        if c.solver.integrator.is_explicit() {
+            return Err(format!(
+                "solver.adaptive works with the implicit integrators; {} is stable only below a fixed \
+                 limit: set solver.adaptive.enabled = false or solver.integrator = \"implicit-euler\"",
+                c.solver.integrator
+            ));
+        }
     }
     if c.solver.dt > c.scene.duration {
         return Err(format!("solver.dt = {} s is longer than scene.duration = {} s", c.solver.dt, c.scene.duration));

@@ -1,7 +1,7 @@
 //! Running a scene to its end: the step loop, divergence handling and the metrics report.
 
 use super::Scene;
-use crate::sim::StepError;
+use crate::sim::{StepError, StepTimings};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -10,7 +10,7 @@ use std::time::Instant;
 pub struct Metrics {
     pub preset: String,
     pub integrator: String,
-    /// Time step, s.
+    /// Time step, s (the first, with adaptive steps: `simulated_seconds / steps` is their mean).
     pub dt: f64,
     pub vertices: usize,
     pub triangles: usize,
@@ -45,6 +45,13 @@ pub struct Metrics {
     pub contact_events: Option<serde_json::Value>,
     pub newton_iterations: u64,
     pub cg_iterations: u64,
+    /// Peak resident memory of the process, bytes (Linux; absent elsewhere).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_memory_bytes: Option<u64>,
+    /// Steps the adaptive control took again with a smaller Δt.
+    pub rejected_steps: u64,
+    /// Seconds of the run spent in each phase of the steps.
+    pub step_time: StepTimings,
     pub measures: serde_json::Value,
 }
 
@@ -60,23 +67,31 @@ pub struct RunOptions<'a> {
 pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics, Option<StepError>) {
     let duration = options.duration.unwrap_or(scene.config.scene.duration);
     let dt = scene.integrator.dt;
-    let steps = (duration / dt - 1e-9).ceil().max(1.0) as u64;
+    let end_time = scene.state.time + duration;
     let mut progress = options.progress;
     let wall = Instant::now();
     let cpu = cpu_time::ProcessTime::now();
     let start_time = scene.state.time;
     let (mut newton, mut cg) = (0u64, 0u64);
+    let mut step_time = StepTimings::default();
+    let mut rejected = 0u64;
     let mut error = None;
     let settle_speed = scene.config.scene.settle_speed;
     let settle_window = scene.config.scene.settle_window;
     let total_mass: f64 = scene.model.mass.iter().sum();
     // Start of the current run of slow steps, and when the cloth settled.
     let (mut slow_since, mut settle_time): (Option<f64>, Option<f64>) = (None, None);
-    for k in 0..steps {
+    let mut k = 0u64;
+    // Steps until the end time is reached (a fixed Δt that does not divide the duration
+    // ends past it).
+    while scene.state.time < end_time - 1e-6 * scene.integrator.dt {
+        k += 1;
         match scene.step() {
             Ok(report) => {
                 newton += report.newton_iterations as u64;
                 cg += report.cg_iterations as u64;
+                step_time += report.timings;
+                rejected += report.rejected as u64;
             }
             Err(e) => {
                 error = Some(e);
@@ -99,7 +114,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             }
         }
         if let (Some(p), true) = (progress.as_deref_mut(), k.is_multiple_of(16)) {
-            p((k + 1) as f64 / steps as f64);
+            p(((scene.state.time - start_time) / duration).min(1.0));
         }
     }
     let cpu_seconds = cpu.elapsed().as_secs_f64();
@@ -132,7 +147,18 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         }),
         newton_iterations: newton,
         cg_iterations: cg,
+        rejected_steps: rejected,
+        peak_memory_bytes: peak_memory_bytes(),
+        step_time,
         measures: scene.measures(),
     };
     (metrics, error)
+}
+
+/// The process's peak resident set (VmHWM in /proc/self/status), bytes.
+fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }

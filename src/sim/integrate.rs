@@ -14,9 +14,10 @@
 
 use crate::sim::contact::{ContactModel, ContactStats, StepContacts};
 use crate::sim::model::Model;
-use crate::sim::sparse::{SystemMatrix, pcg};
+use crate::sim::sparse::{Preconditioner, SystemMatrix, pcg};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+use std::time::Instant;
 use thiserror::Error;
 
 /// Positions and velocities at a time.
@@ -108,6 +109,45 @@ impl Default for NewtonSettings {
     }
 }
 
+/// Adaptive time steps for the implicit integrators: each step's local position error is
+/// estimated and the next Δt chosen to keep it near `tolerance`; a step whose error is more
+/// than twice that, or whose Newton solve did not converge, is taken again with a smaller Δt.
+///
+/// Implicit Euler's position after one step is x_n + h v_n + h² a_{n+1} where the exact
+/// motion gives x_n + h v_n + ½h² a: the local error is ½h²|a| = ½h|v_{n+1} − v_n|, largest
+/// where the cloth accelerates (a fall, a buckling snap) and vanishing when it moves
+/// steadily or rests. Δt then grows as h ∝ √(tolerance/|a|). For BDF2 the same estimate is
+/// conservative (its error is third order); its two-step history is restarted whenever Δt
+/// changes, as its fixed-step formula requires.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AdaptiveStep {
+    /// Off: Δt stays at `solver.dt` (so that a preset's adaptive section can be switched off
+    /// from the command line).
+    pub enabled: bool,
+    /// Largest local position error per step, m.
+    pub tolerance: f64,
+    /// Smallest and largest Δt, s.
+    pub dt_min: f64,
+    pub dt_max: f64,
+}
+
+impl Default for AdaptiveStep {
+    fn default() -> Self {
+        Self { enabled: true, tolerance: 1e-4, dt_min: 1e-5, dt_max: 0.02 }
+    }
+}
+
+impl AdaptiveStep {
+    /// The factor by which Δt should change after a step whose error estimate was `error`.
+    fn factor(&self, error: f64) -> f64 {
+        if error <= 0.0 {
+            return 1.5;
+        }
+        (0.9 * (self.tolerance / error).sqrt()).clamp(0.25, 1.5)
+    }
+}
+
 /// Why a step was rejected.
 #[derive(Debug, Clone, Error, PartialEq)]
 pub enum StepError {
@@ -126,13 +166,58 @@ pub struct StepReport {
     pub cg_iterations: usize,
     /// True when Newton stopped at its iteration limit before reaching its tolerance.
     pub newton_unconverged: bool,
+    /// Where the step's time went.
+    pub timings: StepTimings,
+    /// The time step taken, s.
+    pub dt: f64,
+    /// Attempts thrown away by the adaptive step control before this one stood.
+    pub rejected: usize,
+}
+
+impl StepReport {
+    /// Adds another attempt's work (iterations and time).
+    fn add_work(&mut self, other: &StepReport) {
+        self.newton_iterations += other.newton_iterations;
+        self.cg_iterations += other.cg_iterations;
+        self.timings += other.timings;
+    }
+}
+
+/// Wall-clock seconds of one step (or a sum of steps) by phase, on the calling thread.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct StepTimings {
+    /// Elastic forces and energies (line search included) and Hessian assembly.
+    pub forces: f64,
+    /// The linear solves (preconditioner set-up and conjugate gradient).
+    pub solve: f64,
+    /// Collision detection and response: planes, cloth–cloth pairs, CCD, contact forces
+    /// and Hessians, the self-crossing fail-safe.
+    pub contact: f64,
+}
+
+impl std::ops::AddAssign for StepTimings {
+    fn add_assign(&mut self, o: Self) {
+        self.forces += o.forces;
+        self.solve += o.solve;
+        self.contact += o.contact;
+    }
+}
+
+/// Seconds since `start`, resetting it to now.
+fn lap(start: &mut Instant) -> f64 {
+    let now = Instant::now();
+    let seconds = (now - *start).as_secs_f64();
+    *start = now;
+    seconds
 }
 
 /// Advances states with a chosen integrator and time step, reusing its work buffers.
 pub struct Integrator {
     pub kind: IntegratorKind,
-    /// Time step, s.
+    /// Time step, s (the next one to try, when adaptive).
     pub dt: f64,
+    /// Adaptive time steps (implicit integrators only); None: Δt stays fixed.
+    pub adaptive: Option<AdaptiveStep>,
     pub newton: NewtonSettings,
     /// A state whose largest edge stretch exceeds this ratio has blown up.
     pub max_stretch: f64,
@@ -143,16 +228,72 @@ pub struct Integrator {
 
 impl Integrator {
     pub fn new(kind: IntegratorKind, dt: f64) -> Self {
-        Self { kind, dt, newton: NewtonSettings::default(), max_stretch: 4.0, forces: Vec::new(), contact_stats: ContactStats::default() }
+        Self {
+            kind,
+            dt,
+            adaptive: None,
+            newton: NewtonSettings::default(),
+            max_stretch: 4.0,
+            forces: Vec::new(),
+            contact_stats: ContactStats::default(),
+        }
     }
 
-    /// Advances `state` by one step. On error `state` is unchanged.
+    /// Advances `state` by one step (of `self.dt`, or as the adaptive control decides). On
+    /// error `state` is unchanged.
     pub fn step(&mut self, model: &Model, state: &mut State) -> Result<StepReport, StepError> {
+        let Some(adaptive) = self.adaptive.filter(|a| a.enabled && !self.kind.is_explicit()) else {
+            return self.fixed_step(model, state);
+        };
+        let mut discarded = StepReport::default();
+        loop {
+            let dt = self.dt;
+            let mut trial = state.clone();
+            let outcome = self.fixed_step(model, &mut trial);
+            let smaller = (dt * 0.25).max(adaptive.dt_min);
+            let at_floor = dt <= adaptive.dt_min * (1.0 + 1e-9);
+            match outcome {
+                Ok(mut report) => {
+                    let error = (0..trial.x.len())
+                        .filter(|&i| !model.fixed[i])
+                        .map(|i| 0.5 * dt * (trial.v[i] - state.v[i]).length())
+                        .fold(0.0, f64::max);
+                    let factor = adaptive.factor(error);
+                    if !at_floor && (error > 2.0 * adaptive.tolerance || report.newton_unconverged) {
+                        discarded.add_work(&report);
+                        discarded.rejected += 1;
+                        self.dt = (dt * factor.min(0.5)).max(adaptive.dt_min);
+                        continue;
+                    }
+                    *state = trial;
+                    // Small changes are not worth BDF2's restart.
+                    if !(0.9..=1.25).contains(&factor) {
+                        self.dt = (dt * factor).clamp(adaptive.dt_min, adaptive.dt_max);
+                    }
+                    if self.dt != dt {
+                        state.previous = None;
+                    }
+                    report.add_work(&discarded);
+                    report.rejected = discarded.rejected;
+                    return Ok(report);
+                }
+                Err(_) if !at_floor => {
+                    self.dt = smaller;
+                    discarded.rejected += 1;
+                }
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// One step of `self.dt`. On error `state` is unchanged.
+    fn fixed_step(&mut self, model: &Model, state: &mut State) -> Result<StepReport, StepError> {
         let mut next = state.clone();
         let report = match self.kind {
             IntegratorKind::SymplecticEuler => {
-                self.symplectic_euler(model, &mut next);
-                StepReport::default()
+                let mut report = StepReport::default();
+                self.symplectic_euler(model, &mut next, &mut report.timings);
+                report
             }
             IntegratorKind::ImplicitEuler => self.implicit(model, &mut next, false),
             IntegratorKind::Bdf2 => self.implicit(model, &mut next, true),
@@ -167,7 +308,7 @@ impl Integrator {
             return Err(StepError::Diverged { integrator, dt, time, reason });
         }
         *state = next;
-        Ok(report)
+        Ok(StepReport { dt: self.dt, ..report })
     }
 
     fn check(&self, model: &Model, next: &State, time: f64) -> Result<(), StepError> {
@@ -189,8 +330,9 @@ impl Integrator {
 
     /// v ← (v + Δt f/m) / (1 + ζΔt); x ← x + Δt v. Damping is taken implicitly so that it
     /// never limits the step; fixed vertices follow their prescribed motion.
-    fn symplectic_euler(&mut self, model: &Model, s: &mut State) {
+    fn symplectic_euler(&mut self, model: &Model, s: &mut State, timings: &mut StepTimings) {
         let dt = self.dt;
+        let mut clock = Instant::now();
         self.forces.resize(s.x.len(), DVec3::ZERO);
         model.forces(&s.x, &mut self.forces);
         let damping = 1.0 / (1.0 + model.options.damping * dt);
@@ -206,9 +348,11 @@ impl Integrator {
                 s.x[i] += dt * s.v[i];
             }
         }
+        timings.forces += lap(&mut clock);
         if let Some(contact) = &model.contact {
             contact.project_explicit(&start, &mut s.x, &mut s.v, &model.fixed);
             self.finish_contact(model, contact, &start, s);
+            timings.contact += lap(&mut clock);
         }
         s.previous = None;
     }
@@ -251,6 +395,7 @@ impl Integrator {
         match &model.contact {
             None => self.newton(&step, None, &mut y, &mut report),
             Some(contact) => {
+                let mut clock = Instant::now();
                 // The prediction includes gravity's pull over the step, so that contacts a
                 // falling cloth is about to make are there from the first iteration.
                 let predicted: Vec<DVec3> = (0..n).map(|i| inertial[i] + h * h * model.options.gravity).collect();
@@ -268,10 +413,14 @@ impl Integrator {
                         }
                     }
                 }
+                report.timings.contact += lap(&mut clock);
                 // Solve; a path that enters a prop without a plane adds one and solves again.
                 for pass in 0..4 {
                     self.newton(&step, Some(&contacts), &mut y, &mut report);
-                    if contact.add_missed(&mut contacts, model, &s.x, &y, h) == 0 {
+                    clock = Instant::now();
+                    let missed = contact.add_missed(&mut contacts, model, &s.x, &y, h);
+                    report.timings.contact += lap(&mut clock);
+                    if missed == 0 {
                         break;
                     }
                     self.contact_stats.resolves += 1;
@@ -298,7 +447,9 @@ impl Integrator {
         }
         s.x = y;
         if let Some(contact) = &model.contact {
+            let mut clock = Instant::now();
             self.finish_contact(model, contact, &start, s);
+            report.timings.contact += lap(&mut clock);
         }
         s.previous = Some(previous);
         report
@@ -332,6 +483,10 @@ impl Integrator {
         report.newton_unconverged = true;
         let mut phi_current: Option<f64> = None;
         let mut couplings = Vec::new();
+        let mut factor: Option<(Preconditioner, usize)> = None;
+        let mut last_cg = 0;
+        let mut clock = Instant::now();
+        let mut timings = StepTimings::default();
         for _ in 0..self.newton.max_iterations {
             self.forces.resize(n, DVec3::ZERO);
             model.forces(y, &mut self.forces);
@@ -343,7 +498,7 @@ impl Integrator {
                     model.mass[i] / (h * h) * (y[i] - inertial[i]) + zeta * model.mass[i] / h * (y[i] - anchor[i]) - forces[i]
                 };
             }
-            model.assemble_membrane_stiffness(y, &mut stiffness);
+            timings.forces += lap(&mut clock);
             if let Some(c) = contacts {
                 c.add_gradient(y, anchor, &mut gradient, &model.fixed);
                 for (g, &f) in gradient.iter_mut().zip(&model.fixed) {
@@ -351,11 +506,17 @@ impl Integrator {
                         *g = DVec3::ZERO;
                     }
                 }
+                timings.contact += lap(&mut clock);
+            }
+            model.assemble_membrane_stiffness(y, &mut stiffness);
+            let bending = model.bending_newton_matrix(y);
+            timings.forces += lap(&mut clock);
+            if let Some(c) = contacts {
                 c.add_hessian(y, anchor, &mut stiffness);
                 couplings.clear();
                 c.couplings(y, &mut couplings);
+                timings.contact += lap(&mut clock);
             }
-            let bending = model.bending_newton_matrix(y);
             let system = SystemMatrix {
                 mass_diagonal: &mass_diagonal,
                 stiffness: &stiffness,
@@ -364,8 +525,19 @@ impl Integrator {
                 couplings: &couplings,
             };
             let rhs: Vec<DVec3> = gradient.iter().map(|g| -*g).collect();
-            let cg = pcg(&system, &rhs, &mut direction, self.newton.cg_tolerance, self.newton.cg_max_iterations);
-            report.cg_iterations += cg.iterations;
+            // The factor of the step's first iteration serves the later ones while it keeps
+            // the conjugate gradient as quick as it was then.
+            let stale = factor.as_ref().is_none_or(|(_, fresh)| last_cg > 2 * fresh + 5);
+            if stale {
+                factor = Some((system.preconditioner(), usize::MAX));
+            }
+            let (preconditioner, fresh) = factor.as_mut().expect("built above");
+            let cg = pcg(&system, preconditioner, &rhs, &mut direction, self.newton.cg_tolerance, self.newton.cg_max_iterations);
+            if stale {
+                *fresh = cg.iterations;
+            }
+            last_cg = cg.iterations;
+            timings.solve += lap(&mut clock);
             if all_free {
                 // The elastic Hessian annihilates translations, so adding a constant c to d
                 // changes only the mass term of H d. Choosing c so that Σ M (d + c) = −Σ g
@@ -379,6 +551,7 @@ impl Integrator {
                 let shift = -residual / mass_sum;
                 direction.iter_mut().for_each(|d| *d += shift);
             }
+            report.cg_iterations += cg.iterations;
             report.newton_iterations += 1;
             let slope: f64 = gradient.iter().zip(&direction).map(|(g, d)| g.dot(*d)).sum();
             if slope >= 0.0 {
@@ -406,6 +579,7 @@ impl Integrator {
                 alpha *= 0.5;
             }
             phi_current = Some(phi).filter(|_| accepted);
+            timings.forces += lap(&mut clock);
             let step_size = alpha * direction.iter().map(|d| d.length()).fold(0.0, f64::max);
             if !accepted {
                 // Φ cannot be decreased measurably: at round-off level we are converged;
@@ -421,6 +595,7 @@ impl Integrator {
                 break;
             }
         }
+        report.timings += timings;
     }
 }
 

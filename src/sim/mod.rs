@@ -9,7 +9,7 @@ pub mod model;
 pub mod sparse;
 
 pub use curve::PiecewiseLinear;
-pub use integrate::{Integrator, IntegratorKind, NewtonSettings, State, StepError, StepReport};
+pub use integrate::{AdaptiveStep, Integrator, IntegratorKind, NewtonSettings, State, StepError, StepReport, StepTimings};
 pub use material::{BendingStiffness, Fabric, FabricError, MembraneLaw};
 pub use mesh::{Mesh, MeshError, Pattern};
 pub use model::{Model, ModelError, Motion, PhysicsOptions};

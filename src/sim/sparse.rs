@@ -43,6 +43,25 @@ fn pattern(n: usize, pairs: impl Iterator<Item = (u32, u32)>) -> (Vec<u32>, Vec<
     (row_start, cols)
 }
 
+/// Below this many rows a product runs on the calling thread: spreading a few thousand
+/// rows over threads costs more in scheduling than it saves.
+const PARALLEL_ROWS: usize = 4096;
+
+/// Calls `f(row, &mut y[row])` for every row, in chunks over rayon's pool when `y` is long.
+fn for_rows(y: &mut [DVec3], f: impl Fn(usize, &mut DVec3) + Sync) {
+    use rayon::prelude::*;
+    const CHUNK: usize = 1024;
+    if y.len() < PARALLEL_ROWS {
+        y.iter_mut().enumerate().for_each(|(row, out)| f(row, out));
+    } else {
+        y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, chunk)| {
+            for (i, out) in chunk.iter_mut().enumerate() {
+                f(c * CHUNK + i, out);
+            }
+        });
+    }
+}
+
 fn find_slot(row_start: &[u32], cols: &[u32], row: u32, col: u32) -> usize {
     let (s, e) = (row_start[row as usize] as usize, row_start[row as usize + 1] as usize);
     s + cols[s..e].binary_search(&col).expect("entry must be in the sparsity pattern")
@@ -69,16 +88,16 @@ impl BlockCsr {
         self.values.fill(DMat3::ZERO);
     }
 
-    /// y = A x (y overwritten).
+    /// y = A x (y overwritten); rows in parallel on large meshes.
     pub fn multiply(&self, x: &[DVec3], y: &mut [DVec3]) {
-        for (row, out) in y.iter_mut().enumerate() {
+        for_rows(y, |row, out| {
             let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
             let mut acc = DVec3::ZERO;
             for k in s..e {
                 acc += self.values[k] * x[self.cols[k] as usize];
             }
             *out = acc;
-        }
+        });
     }
 
     pub fn vertex_count(&self) -> usize {
@@ -97,16 +116,16 @@ impl ScalarCsr {
         find_slot(&self.row_start, &self.cols, row, col)
     }
 
-    /// y += A x, the scalar matrix acting on each coordinate.
+    /// y += A x, the scalar matrix acting on each coordinate; rows in parallel on large meshes.
     pub fn multiply_add(&self, x: &[DVec3], y: &mut [DVec3]) {
-        for (row, out) in y.iter_mut().enumerate() {
+        for_rows(y, |row, out| {
             let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
             let mut acc = DVec3::ZERO;
             for k in s..e {
                 acc += self.values[k] * x[self.cols[k] as usize];
             }
             *out += acc;
-        }
+        });
     }
 
     pub fn diagonal(&self, row: u32) -> f64 {
@@ -176,7 +195,7 @@ impl SystemMatrix<'_> {
 
     /// The preconditioner: incomplete Cholesky on the in-plane pattern, or block Jacobi if
     /// that factorisation breaks down even with a diagonal shift.
-    fn preconditioner(&self) -> Preconditioner {
+    pub fn preconditioner(&self) -> Preconditioner {
         for shift in [0.0, 1e-3, 1e-2, 1e-1] {
             if let Some(factor) = IncompleteCholesky::new(self, shift) {
                 return Preconditioner::IncompleteCholesky(factor);
@@ -201,7 +220,10 @@ impl SystemMatrix<'_> {
     }
 }
 
-enum Preconditioner {
+/// An approximate inverse of a [`SystemMatrix`] for [`pcg`]; any symmetric positive
+/// definite one works, so one built for a nearby matrix (an earlier Newton iteration of the
+/// same step) can be reused.
+pub enum Preconditioner {
     BlockJacobi(Vec<DMat3>),
     IncompleteCholesky(IncompleteCholesky),
 }
@@ -224,7 +246,7 @@ impl Preconditioner {
 /// diagonal is each row's last entry. The bending matrix's wider entries are left out of
 /// the factor (they are still in the matrix CG solves with). Written by hand: the pattern
 /// is the mesh's, and no sparse-factorisation crate we could use takes it as it is.
-struct IncompleteCholesky {
+pub struct IncompleteCholesky {
     row_start: Vec<usize>,
     cols: Vec<u32>,
     values: Vec<f64>,
@@ -349,9 +371,15 @@ fn dot(a: &[DVec3], b: &[DVec3]) -> f64 {
 
 /// Solves `A x = b` by preconditioned conjugate gradients from `x = 0`, to a residual of
 /// `tolerance · |b|`. `A` must be symmetric positive definite on the free vertices.
-pub fn pcg(a: &SystemMatrix, b: &[DVec3], x: &mut [DVec3], tolerance: f64, max_iterations: usize) -> CgReport {
+pub fn pcg(
+    a: &SystemMatrix,
+    preconditioner: &Preconditioner,
+    b: &[DVec3],
+    x: &mut [DVec3],
+    tolerance: f64,
+    max_iterations: usize,
+) -> CgReport {
     let n = b.len();
-    let preconditioner = a.preconditioner();
     x.fill(DVec3::ZERO);
     let mut r: Vec<DVec3> = b.iter().zip(a.fixed).map(|(&v, &f)| if f { DVec3::ZERO } else { v }).collect();
     let b_norm = dot(&r, &r).sqrt();
@@ -413,7 +441,7 @@ mod tests {
         let a = SystemMatrix { mass_diagonal: &mass, stiffness: &k, bending: None, fixed: &fixed, couplings: &[] };
         let b = vec![DVec3::new(1.0, 0.0, 2.0), DVec3::new(-1.0, 3.0, 0.0), DVec3::new(0.5, 0.5, 0.5)];
         let mut x = vec![DVec3::ZERO; 3];
-        let report = pcg(&a, &b, &mut x, 1e-12, 100);
+        let report = pcg(&a, &a.preconditioner(), &b, &mut x, 1e-12, 100);
         assert!(report.relative_residual < 1e-12);
         let mut ax = vec![DVec3::ZERO; 3];
         a.apply(&x, &mut ax);

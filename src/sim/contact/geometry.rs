@@ -3,7 +3,7 @@
 //! parry3d's versions work on f32 shapes built per query.
 
 use glam::DVec3;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 /// Closest point of triangle (a, b, c) to p, with its barycentric weights (Ericson,
 /// Real-Time Collision Detection, §5.1.5).
@@ -203,12 +203,14 @@ pub fn edge_edge_ccd(p1: [DVec3; 2], q1: [DVec3; 2], p2: [DVec3; 2], q2: [DVec3;
 /// handful of cells.
 pub struct SpatialHash {
     cell: f64,
-    cells: HashMap<[i32; 3], Vec<u32>>,
+    // Fx hashing: the keys are small integer triples, and std's SipHash took as long as
+    // the collision tests it feeds.
+    cells: FxHashMap<[i32; 3], Vec<u32>>,
 }
 
 impl SpatialHash {
     pub fn new(cell: f64) -> Self {
-        Self { cell, cells: HashMap::new() }
+        Self { cell, cells: FxHashMap::default() }
     }
 
     fn key(&self, p: DVec3) -> [i32; 3] {

@@ -1,0 +1,218 @@
+//! `rosette bench`: the paper's Table 1 scenes and the Cusick drape at growing triangle
+//! counts, each run as a child `rosette run` so that every case gets a fresh process: its
+//! peak memory is its own and its thread count is set before rayon's pool exists.
+//!
+//! Reports CPU seconds per simulated second (the paper's unit ×100), the split of step time
+//! into forces, linear solves and contact, memory per vertex (the peak resident size's
+//! growth between the smallest and the largest drape, per vertex added) and the wall-clock
+//! speed-up from one thread to two.
+
+use anyhow::{Context, Result, bail};
+use serde::Serialize;
+use std::io::Write;
+use std::path::Path;
+use std::process::Command;
+
+/// One benchmark case: a scene, its overrides and the simulated window it runs.
+struct Case {
+    name: String,
+    preset: &'static str,
+    overrides: Vec<String>,
+    /// Simulated seconds, or None for the scene's own duration (runs to settling).
+    duration: Option<f64>,
+    /// The paper's Table 1 CPU seconds per 10 ms, where it has this scene.
+    paper: Option<f64>,
+}
+
+/// One measured run.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchRow {
+    pub case: String,
+    pub threads: usize,
+    pub triangles: u64,
+    pub vertices: u64,
+    pub steps: u64,
+    pub simulated_seconds: f64,
+    pub wall_seconds: f64,
+    pub cpu_seconds_per_simulated_second: f64,
+    pub wall_seconds_per_simulated_second: f64,
+    /// Shares of step time.
+    pub forces_share: f64,
+    pub solve_share: f64,
+    pub contact_share: f64,
+    pub newton_per_step: f64,
+    pub cg_per_newton: f64,
+    pub peak_memory_mb: f64,
+    pub paper_cpu_seconds_per_10ms: Option<f64>,
+}
+
+/// Triangles of a `cusick-drape` disc at edge length `edge` are about 875·(0.0155/edge)².
+fn drape_edge_for(triangles: f64) -> f64 {
+    0.0155 * (875.0 / triangles).sqrt()
+}
+
+fn cases(quick: bool) -> Vec<Case> {
+    let case = |name: &str, preset, overrides: Vec<String>, duration, paper| Case {
+        name: name.to_string(),
+        preset,
+        overrides,
+        duration,
+        paper,
+    };
+    let mut out = vec![
+        case("tensile-bias", "tensile-bias", vec![], Some(if quick { 0.5 } else { 6.0 }), Some(8.06)),
+        case("euler-buckling", "euler-buckling", vec![], Some(if quick { 0.2 } else { 2.0 }), Some(1.39)),
+        case("shear-buckling", "shear-buckling", vec![], Some(if quick { 0.2 } else { 2.2 }), Some(9.58)),
+    ];
+    if !quick {
+        // The whole drape, to settling: the paper's Fig. 6 scene.
+        out.push(case("cusick-drape, to settling", "cusick-drape", vec![], None, Some(9.36)));
+    }
+    let sizes: &[f64] = if quick { &[800.0, 5000.0] } else { &[800.0, 5000.0, 20000.0, 80000.0] };
+    let window = if quick { 0.1 } else { 0.5 };
+    for &n in sizes {
+        out.push(case(
+            &format!("cusick-drape ~{} tri, first {window} s", n as u64),
+            "cusick-drape",
+            vec![format!("mesh.edge_length={:.5}", drape_edge_for(n))],
+            Some(window),
+            None,
+        ));
+    }
+    out
+}
+
+/// Runs `case` in a child process with `threads` rayon threads.
+fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
+    let mut cmd = Command::new(exe);
+    cmd.arg("run").arg(case.preset).args(["--metrics", "-"]).env("RAYON_NUM_THREADS", threads.to_string());
+    for o in &case.overrides {
+        cmd.args(["--set", o]);
+    }
+    if let Some(d) = case.duration {
+        cmd.args(["--duration", &d.to_string()]);
+    }
+    let output = cmd.output().with_context(|| format!("starting {}", exe.display()))?;
+    if !output.status.success() {
+        bail!("{}: rosette run failed: {}", case.name, String::from_utf8_lossy(&output.stderr).trim());
+    }
+    let m: serde_json::Value = serde_json::from_slice(&output.stdout).context("reading the run's metrics")?;
+    let f = |key: &str| m[key].as_f64().unwrap_or(f64::NAN);
+    let split = &m["step_time"];
+    let (forces, solve, contact) =
+        (split["forces"].as_f64().unwrap_or(0.0), split["solve"].as_f64().unwrap_or(0.0), split["contact"].as_f64().unwrap_or(0.0));
+    let total = (forces + solve + contact).max(f64::MIN_POSITIVE);
+    let steps = m["steps"].as_u64().unwrap_or(0);
+    let newton = f("newton_iterations");
+    let simulated = f("simulated_seconds");
+    Ok(BenchRow {
+        case: case.name.clone(),
+        threads,
+        triangles: m["triangles"].as_u64().unwrap_or(0),
+        vertices: m["vertices"].as_u64().unwrap_or(0),
+        steps,
+        simulated_seconds: simulated,
+        wall_seconds: f("wall_seconds"),
+        cpu_seconds_per_simulated_second: f("cpu_seconds_per_simulated_second"),
+        wall_seconds_per_simulated_second: f("wall_seconds") / simulated,
+        forces_share: forces / total,
+        solve_share: solve / total,
+        contact_share: contact / total,
+        newton_per_step: newton / steps.max(1) as f64,
+        cg_per_newton: f("cg_iterations") / newton.max(1.0),
+        peak_memory_mb: m["peak_memory_bytes"].as_f64().unwrap_or(f64::NAN) / 1e6,
+        paper_cpu_seconds_per_10ms: case.paper,
+    })
+}
+
+/// Runs the benchmark and writes `bench.csv` and `bench.json` into `out`.
+pub fn run(out: &Path, quick: bool, threads: &[usize]) -> Result<Vec<BenchRow>> {
+    let exe = std::env::current_exe().context("locating the rosette executable")?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut rows = Vec::new();
+    println!(
+        "{:<46} {:>3} {:>7} {:>10} {:>10} {:>6} {:>6} {:>6} {:>7} {:>7} {:>8}",
+        "case", "thr", "tris", "CPU s/s", "wall s/s", "forces", "solve", "contact", "newton", "cg/nwt", "peak MB"
+    );
+    for case in cases(quick) {
+        for &t in threads {
+            let row = run_case(&exe, &case, t)?;
+            println!(
+                "{:<46} {:>3} {:>7} {:>10.4} {:>10.4} {:>5.0}% {:>5.0}% {:>6.0}% {:>7.2} {:>7.1} {:>8.1}",
+                row.case,
+                row.threads,
+                row.triangles,
+                row.cpu_seconds_per_simulated_second,
+                row.wall_seconds_per_simulated_second,
+                100.0 * row.forces_share,
+                100.0 * row.solve_share,
+                100.0 * row.contact_share,
+                row.newton_per_step,
+                row.cg_per_newton,
+                row.peak_memory_mb
+            );
+            rows.push(row);
+        }
+    }
+    summarise(&rows);
+    write_csv(&out.join("bench.csv"), &rows)?;
+    std::fs::write(out.join("bench.json"), serde_json::to_string_pretty(&rows)?)?;
+    println!("wrote {} and {}", out.join("bench.csv").display(), out.join("bench.json").display());
+    Ok(rows)
+}
+
+/// Prints the ratios the rows imply: against the paper, thread speed-up, memory per vertex.
+fn summarise(rows: &[BenchRow]) {
+    for r in rows.iter().filter(|r| r.threads == 1) {
+        if let Some(paper) = r.paper_cpu_seconds_per_10ms {
+            let ours = r.cpu_seconds_per_simulated_second * 0.01;
+            println!("{}: {ours:.5} CPU s per 10 ms, {:.0}x faster than the paper's {paper}", r.case, paper / ours);
+        }
+        if let Some(two) = rows.iter().find(|o| o.case == r.case && o.threads == 2) {
+            println!("{}: 1 -> 2 threads, wall-clock speed-up {:.2}x", r.case, r.wall_seconds / two.wall_seconds);
+        }
+    }
+    let drapes: Vec<&BenchRow> = rows.iter().filter(|r| r.threads == 1 && r.case.contains("first")).collect();
+    if let (Some(small), Some(large)) = (drapes.first(), drapes.last())
+        && large.vertices > small.vertices
+    {
+        let per_vertex = (large.peak_memory_mb - small.peak_memory_mb) * 1e6 / (large.vertices - small.vertices) as f64;
+        println!("memory: {per_vertex:.0} bytes per vertex (peak resident growth from {} to {} vertices)", small.vertices, large.vertices);
+        let growth = (large.cpu_seconds_per_simulated_second / small.cpu_seconds_per_simulated_second)
+            / (large.triangles as f64 / small.triangles as f64);
+        println!("cost growth: CPU per simulated second grows {growth:.2}x faster than the triangle count");
+    }
+}
+
+fn write_csv(path: &Path, rows: &[BenchRow]) -> Result<()> {
+    let mut f = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    writeln!(
+        f,
+        "case,threads,triangles,vertices,steps,simulated_seconds,wall_seconds,cpu_seconds_per_simulated_second,\
+         wall_seconds_per_simulated_second,forces_share,solve_share,contact_share,newton_per_step,cg_per_newton,\
+         peak_memory_mb,paper_cpu_seconds_per_10ms"
+    )?;
+    for r in rows {
+        writeln!(
+            f,
+            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            r.case,
+            r.threads,
+            r.triangles,
+            r.vertices,
+            r.steps,
+            r.simulated_seconds,
+            r.wall_seconds,
+            r.cpu_seconds_per_simulated_second,
+            r.wall_seconds_per_simulated_second,
+            r.forces_share,
+            r.solve_share,
+            r.contact_share,
+            r.newton_per_step,
+            r.cg_per_newton,
+            r.peak_memory_mb,
+            r.paper_cpu_seconds_per_10ms.map_or(String::new(), |p| p.to_string())
+        )?;
+    }
+    Ok(())
+}
