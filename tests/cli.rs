@@ -307,3 +307,37 @@ fn metrics_dash_writes_json_to_stdout() {
     assert_eq!(metrics["preset"], "tensile-warp");
     assert_eq!(metrics["stable"], true);
 }
+
+/// `rosette bench --quick` times the Table 1 scenes and two drape sizes in child runs and
+/// writes one CSV row per case and thread count, with the step time split into shares that
+/// add up, and the child's own peak memory.
+#[test]
+fn bench_quick_writes_one_row_per_case() {
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("bench-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let output = rosette(&["bench", "--quick", "--threads", "1", "--out", out.to_str().unwrap()]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for key in ["case", "threads", "triangles", "cpu_seconds_per_simulated_second", "forces_share", "solve_share", "contact_share", "peak_memory_mb"] {
+        assert!(header.contains(&key), "bench.csv lacks {key}: {header:?}");
+    }
+    // The case name is quoted (it may hold commas); the columns after it are numbers.
+    let rows: Vec<Vec<&str>> = lines.map(|l| l[l.rfind("\",").expect("a quoted case") + 2..].split(',').collect()).collect();
+    assert_eq!(rows.len(), 5, "three Table 1 scenes and two drape sizes:\n{csv}");
+    let column = |row: &Vec<&str>, key: &str| -> f64 {
+        let i = header.iter().position(|h| *h == key).unwrap();
+        row[i - 1].parse().unwrap_or(f64::NAN)
+    };
+    for row in &rows {
+        assert!(column(row, "cpu_seconds_per_simulated_second") > 0.0, "{row:?}");
+        let shares = column(row, "forces_share") + column(row, "solve_share") + column(row, "contact_share");
+        assert!((shares - 1.0).abs() < 1e-9, "shares add to {shares}: {row:?}");
+        assert!(column(row, "peak_memory_mb") > 1.0, "{row:?}");
+    }
+    // The drapes (the last two rows) are the only cases with contact, and the larger has
+    // more triangles.
+    assert!(column(&rows[3], "contact_share") > 0.0 && column(&rows[0], "contact_share") == 0.0);
+    assert!(column(&rows[4], "triangles") > 4.0 * column(&rows[3], "triangles"));
+}

@@ -101,11 +101,15 @@ pub struct NewtonSettings {
     pub cg_tolerance: f64,
     /// Maximum conjugate-gradient iterations per Newton iteration.
     pub cg_max_iterations: usize,
+    /// Inexact Newton (Eisenstat and Walker's second forcing term): early iterations, far
+    /// from the solution, solve their linear systems only to η_k = 0.9(|g_k|/|g_{k−1}|)²
+    /// (at most 0.1, at least `cg_tolerance`) instead of `cg_tolerance`.
+    pub forcing: bool,
 }
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { max_iterations: 30, tolerance: 1e-5, cg_tolerance: 1e-3, cg_max_iterations: 3000 }
+        Self { max_iterations: 30, tolerance: 1e-5, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true }
     }
 }
 
@@ -485,6 +489,7 @@ impl Integrator {
         let mut couplings = Vec::new();
         let mut factor: Option<(Preconditioner, usize)> = None;
         let mut last_cg = 0;
+        let (mut previous_norm, mut forcing): (Option<f64>, f64) = (None, 0.1);
         let mut clock = Instant::now();
         let mut timings = StepTimings::default();
         for _ in 0..self.newton.max_iterations {
@@ -532,7 +537,24 @@ impl Integrator {
                 factor = Some((system.preconditioner(), usize::MAX));
             }
             let (preconditioner, fresh) = factor.as_mut().expect("built above");
-            let cg = pcg(&system, preconditioner, &rhs, &mut direction, self.newton.cg_tolerance, self.newton.cg_max_iterations);
+            let cg_tolerance = if self.newton.forcing {
+                let norm = gradient.iter().map(|g| g.length_squared()).sum::<f64>().sqrt();
+                let eta = match previous_norm {
+                    None => 0.1,
+                    Some(before) => {
+                        let eta = 0.9 * (norm / before).powi(2);
+                        // Safeguard: do not tighten faster than the previous term allows.
+                        let floor = 0.9 * forcing * forcing;
+                        if floor > 0.1 { eta.max(floor) } else { eta }
+                    }
+                };
+                previous_norm = Some(norm);
+                forcing = eta.clamp(self.newton.cg_tolerance, 0.1);
+                forcing
+            } else {
+                self.newton.cg_tolerance
+            };
+            let cg = pcg(&system, preconditioner, &rhs, &mut direction, cg_tolerance, self.newton.cg_max_iterations);
             if stale {
                 *fresh = cg.iterations;
             }
