@@ -150,7 +150,7 @@ fn accuracy_panel(panel: &Panel, problem: Problem, rows: &[&AccuracyRow]) -> Dra
     chart.draw_series(front.iter().map(|&p| Circle::new(p, 6, BLACK.stroke_width(2))))?;
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::LowerLeft)
         .background_style(WHITE.mix(0.85))
         .border_style(RGBColor(160, 160, 160))
         .label_font(("sans-serif", 13))
@@ -214,21 +214,11 @@ fn stability_panel(panel: &Panel, map: StabilityMap, rows: &[&StabilityRow]) -> 
     let mut limit: Vec<(f64, f64)> = rows.iter().map(|r| (r.stiffness(), r.explicit_limit)).collect();
     limit.sort_by(|a, b| a.0.total_cmp(&b.0));
     limit.dedup_by(|a, b| a.0 == b.0);
-    chart
-        .draw_series(LineSeries::new(limit, BLACK.stroke_width(2)))?
-        .label("explicit limit 2/ω_max")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(2)));
+    chart.draw_series(LineSeries::new(limit, BLACK.stroke_width(2)))?;
     for r in rows {
         let at = (r.stiffness() * integrator_offset(r.integrator), r.dt);
         chart.plotting_area().draw(&marker_on(r.integrator, at, status_colour(r.status)))?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(160, 160, 160))
-        .label_font(("sans-serif", 13))
-        .draw()?;
     Ok(())
 }
 
@@ -245,13 +235,14 @@ fn marker_on<'a, DB: DrawingBackend + 'a, C: Clone + 'a>(kind: IntegratorKind, a
 /// The key under the maps: marker shapes for integrators, colours for statuses.
 fn stability_key(area: &Panel) -> DrawResult {
     let text = ("sans-serif", 14).into_font().color(&BLACK);
-    let mut x = 12;
+    area.draw(&PathElement::new(vec![(12, 20), (36, 20)], BLACK.stroke_width(2)))?;
+    area.draw(&Text::new("explicit limit 2/ω_max", (42, 12), text.clone()))?;
+    let mut x = 210;
     for kind in IntegratorKind::ALL {
         area.draw(&marker_on(kind, (x + 6, 20), RGBColor(90, 90, 90)))?;
         area.draw(&Text::new(kind.name(), (x + 16, 12), text.clone()))?;
-        x += 150;
+        x += 140;
     }
-    x += 20;
     for status in [Status::Bounded, Status::Inaccurate, Status::Diverged] {
         area.draw(&Rectangle::new([(x, 14), (x + 12, 26)], status_colour(status).filled()))?;
         let label = match status {
@@ -259,7 +250,7 @@ fn stability_key(area: &Panel) -> DrawResult {
             s => s.name().to_string(),
         };
         area.draw(&Text::new(label, (x + 18, 12), text.clone()))?;
-        x += if status == Status::Inaccurate { 200 } else { 100 };
+        x += if status == Status::Inaccurate { 190 } else { 95 };
     }
     Ok(())
 }
