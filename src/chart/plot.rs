@@ -98,6 +98,27 @@ pub fn draw_accuracy(path: &Path, rows: &[AccuracyRow], _: &[StabilityRow]) -> R
     save(path, buffer, size)
 }
 
+/// The corner of a log–log panel with the fewest points in it, for the legend.
+fn emptiest_corner(points: &[(f64, f64)], x: &std::ops::Range<f64>, y: &std::ops::Range<f64>) -> SeriesLabelPosition {
+    let fraction = |v: f64, r: &std::ops::Range<f64>| (v.ln() - r.start.ln()) / (r.end.ln() - r.start.ln());
+    let corners = [
+        (SeriesLabelPosition::LowerLeft, false, false),
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+    ];
+    let count = |right: bool, upper: bool| {
+        points
+            .iter()
+            .filter(|&&(px, py)| {
+                let (fx, fy) = (fraction(px, x), fraction(py, y));
+                (if right { fx > 0.55 } else { fx < 0.45 }) && (if upper { fy > 0.6 } else { fy < 0.4 })
+            })
+            .count()
+    };
+    corners.into_iter().min_by_key(|&(_, right, upper)| count(right, upper)).map_or(SeriesLabelPosition::LowerLeft, |c| c.0)
+}
+
 type Panel<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 type DrawResult = Result<(), Box<dyn std::error::Error>>;
 
@@ -110,7 +131,7 @@ fn accuracy_panel(panel: &Panel, problem: Problem, rows: &[&AccuracyRow]) -> Dra
         .margin(10)
         .x_label_area_size(40)
         .y_label_area_size(62)
-        .build_cartesian_2d(x.log_scale(), y.log_scale())?;
+        .build_cartesian_2d(x.clone().log_scale(), y.clone().log_scale())?;
     chart
         .configure_mesh()
         .x_desc("CPU seconds per run")
@@ -148,9 +169,10 @@ fn accuracy_panel(panel: &Panel, problem: Problem, rows: &[&AccuracyRow]) -> Dra
         .label("Pareto front")
         .legend(|(x, y)| Circle::new((x + 9, y), 5, BLACK.stroke_width(2)));
     chart.draw_series(front.iter().map(|&p| Circle::new(p, 6, BLACK.stroke_width(2))))?;
+    let all: Vec<(f64, f64)> = plotted.iter().map(|r| (r.cpu_seconds, r.error.unwrap_or(0.0))).collect();
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
+        .position(emptiest_corner(&all, &x, &y))
         .background_style(WHITE.mix(0.85))
         .border_style(RGBColor(160, 160, 160))
         .label_font(("sans-serif", 13))
