@@ -80,3 +80,20 @@ fn quick_chart_writes_its_tables_and_pictures_and_explicit_runs_fail_above_their
     check_png(&out.join("stability.png"), 2 * w, h + 40);
     std::fs::remove_dir_all(&out).ok();
 }
+
+/// The command line: an output directory that cannot be made is bad input (exit code 2),
+/// reported before any run starts.
+#[test]
+fn chart_command_reports_an_unwritable_output_directory() {
+    let blocker = std::env::temp_dir().join(format!("rosette-chart-blocker-{}", std::process::id()));
+    std::fs::write(&blocker, "a file, not a directory").unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_rosette"))
+        .args(["chart", "--quick", "--out"])
+        .arg(blocker.join("out"))
+        .output()
+        .unwrap();
+    std::fs::remove_file(&blocker).ok();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("cannot write") && stderr.contains("--out"), "{stderr}");
+}

@@ -174,8 +174,8 @@ pub fn run(options: &ChartOptions) -> Result<ChartReport, ChartError> {
     let plan = Plan::new(options.quick);
     let reference_file = out.join("drape-reference.csv");
     let cached = plan.drape_reference.and_then(|c| data::read_drape_reference(&reference_file, &c));
-    // Every run, the uncached drape reference included, goes through one pool. The longest
-    // runs go first so that the pool does not end on one of them alone.
+    // Every run, the uncached drape reference included, goes through one pool. The
+    // reference, the longest run, goes first so that the pool does not end on it alone.
     let mut jobs: Vec<Case> = plan.accuracy.clone();
     jobs.extend(plan.stability.iter().map(|(_, c)| *c));
     if let (Some(reference), None) = (plan.drape_reference, cached) {
