@@ -118,13 +118,13 @@ impl Plan {
                     accuracy.push(case(problem, ImplicitEuler, Step::Seconds(dt), edge));
                     accuracy.push(case(problem, Bdf2, Step::Seconds(dt), edge));
                 }
-                // Explicit drape runs would take tens of thousands of steps with contact:
-                // left out.
-                if problem != Problem::Drape {
+                // An explicit drape takes 22 000 steps with contact on the coarsest mesh
+                // (14 CPU s) and about 100 CPU s on the finest: coarsest mesh only.
+                if problem != Problem::Drape || i == 0 {
                     accuracy.push(case(problem, SymplecticEuler, Step::OfLimit(0.9), edge));
-                    if i == 0 && !quick {
-                        accuracy.push(case(problem, SymplecticEuler, Step::OfLimit(0.45), edge));
-                    }
+                }
+                if i == 0 && !quick && problem != Problem::Drape {
+                    accuracy.push(case(problem, SymplecticEuler, Step::OfLimit(0.45), edge));
                 }
             }
         }
@@ -187,6 +187,12 @@ pub fn run(options: &ChartOptions) -> Result<ChartReport, ChartError> {
         .build()
         .expect("a thread pool");
     let outcomes: Vec<Outcome> = pool.install(|| jobs.par_iter().map(Case::run).collect());
+    // Runs that could not be set up or measured (not divergences, which are results).
+    let failures: Vec<String> = outcomes
+        .iter()
+        .filter(|o| !o.diverged)
+        .filter_map(|o| Some(format!("{} {} dt {:.3e}: {}", o.case.problem.name(), o.case.integrator, o.dt, o.message.as_ref()?)))
+        .collect();
     let mut outcomes = outcomes.into_iter();
     let reference = match (plan.drape_reference, cached) {
         (_, Some(value)) => Some(value),
@@ -220,7 +226,8 @@ pub fn run(options: &ChartOptions) -> Result<ChartReport, ChartError> {
         draw(&path, &accuracy, &stability).map_err(|message| ChartError::Plot { path: path.clone(), message })?;
         files.push(path);
     }
-    let summary = summarise(&accuracy, &stability, reference);
+    let mut summary = summarise(&accuracy, &stability, reference);
+    summary.extend(failures.into_iter().map(|f| format!("failed: {f}")));
     Ok(ChartReport { accuracy, stability, files, summary })
 }
 
