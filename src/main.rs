@@ -39,6 +39,16 @@ enum Command {
         #[command(flatten)]
         screenshot: ScreenshotArgs,
     },
+    /// Sweep integrators, time steps and meshes: error against CPU time and stability
+    /// maps, as CSV and PNG (accuracy.csv/png, stability.csv/png).
+    Chart {
+        /// Directory for the CSV and PNG files (created if missing).
+        #[arg(long, value_name = "DIR", default_value = "chart")]
+        out: std::path::PathBuf,
+        /// The small sweep the tests run: fewer and smaller runs, no drape.
+        #[arg(long)]
+        quick: bool,
+    },
     /// List the bundled scenes.
     Presets,
     /// Time the paper's Table 1 scenes and the Cusick drape at about 800, 5 000, 20 000
@@ -124,8 +134,28 @@ fn main() -> ExitCode {
                 ExitCode::from(EXIT_BAD_INPUT)
             }
         },
+        Some(Command::Chart { out, quick }) => chart(out, quick),
         Some(Command::Run { preset, overrides, duration, metrics, outline, screenshot }) => {
             run(&preset, &overrides, duration, metrics.as_deref(), outline.as_deref(), &screenshot)
+        }
+    }
+}
+
+fn chart(out: std::path::PathBuf, quick: bool) -> ExitCode {
+    let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
+    match rosette::chart::run(&rosette::chart::ChartOptions { out, quick, threads }) {
+        Ok(report) => {
+            for line in &report.summary {
+                println!("{line}");
+            }
+            for file in &report.files {
+                eprintln!("wrote {}", file.display());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(EXIT_BAD_INPUT)
         }
     }
 }

@@ -4,8 +4,10 @@
 //! - [`worker`]: the solver thread, its commands and snapshots (no GUI dependency).
 //! - [`ui`]: the egui panels and the view's mouse and keys, turned into actions.
 //! - [`camera`]: orbit camera and ray picking; [`colour`]: strain/bending colour maps;
-//!   [`plots`]: live test plots and their references; [`files`]: TOML, OBJ, CSV.
+//!   [`plots`]: live test plots and their references; [`files`]: TOML, OBJ, CSV;
+//!   [`chart_view`]: the speed/accuracy charts of `rosette chart`.
 pub mod camera;
+pub mod chart_view;
 pub mod colour;
 pub mod files;
 pub mod plots;

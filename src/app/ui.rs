@@ -4,6 +4,7 @@
 //! `egui::Context`.
 
 use super::camera::OrbitCamera;
+use super::chart_view::ChartView;
 use super::colour::ColourMap;
 use super::plots::{self, History};
 use super::worker::{Command, Snapshot};
@@ -70,6 +71,8 @@ pub struct ViewerUi {
     curve_drag: Option<(usize, usize)>,
     history_choice: String,
     mouse_drag: Option<MouseDrag>,
+    /// The speed/accuracy chart window (`rosette chart`'s tables).
+    pub chart: ChartView,
 }
 
 impl Default for ViewerUi {
@@ -90,6 +93,7 @@ impl Default for ViewerUi {
             curve_drag: None,
             history_choice: String::new(),
             mouse_drag: None,
+            chart: ChartView::default(),
         }
     }
 }
@@ -109,6 +113,7 @@ impl ViewerUi {
             egui::ScrollArea::vertical().show(ui, |ui| self.right_panel(ui, snapshot, &mut actions));
         });
         egui::CentralPanel::no_frame().show(ui, |ui| self.view(ui, snapshot, &mut actions));
+        self.chart.show(ui.ctx());
         self.flush_fabric(&mut actions);
         actions
     }
@@ -199,6 +204,8 @@ impl ViewerUi {
             if ui.button("Save PNG").on_hover_text("F12").clicked() {
                 actions.push(Action::Screenshot);
             }
+            ui.separator();
+            ui.toggle_value(&mut self.chart.open, "Chart").on_hover_text("speed against accuracy: the tables of `rosette chart`");
         });
         if let Some(error) = &snapshot.error {
             ui.colored_label(Color32::from_rgb(255, 110, 100), format!("Error: {error}"));
