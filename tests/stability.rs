@@ -64,3 +64,23 @@ fn reported_limit_separates_stable_from_divergent_steps() {
     }
 }
 
+
+/// An explicit drape above its limit is caught within a few steps, with contact and
+/// self-collision on: the blow-up shows as vertices faster than the cloth's fastest wave,
+/// and its paths are not swept for collisions (that sweep over a scene-sized box never
+/// ended). At ten times the limit the run stops with a divergence, not a hang.
+#[test]
+fn explicit_drape_above_its_limit_is_caught_not_swept() {
+    use rosette::scene::{RunOptions, Scene, load_scene, run_scene};
+    let overrides: Vec<String> =
+        ["mesh.edge_length=0.03", "solver.integrator=symplectic-euler", "solver.dt=0.003"].iter().map(|s| s.to_string()).collect();
+    let (config, _) = load_scene("cusick-drape-30", &overrides).unwrap();
+    let mut scene = Scene::build(config).unwrap();
+    let limit = scene.model.explicit_step_limit(&scene.state.x);
+    assert!(0.003 > 5.0 * limit, "the test needs dt far above the limit {limit:e}");
+    let (metrics, error) = run_scene(&mut scene, "cusick-drape-30", RunOptions { duration: Some(1.0), progress: None });
+    let message = error.expect("the explicit drape must diverge").to_string();
+    println!("{} steps: {message}", metrics.steps);
+    assert!(metrics.steps < 20 && !metrics.stable, "{} steps", metrics.steps);
+    assert!(message.contains("symplectic-euler") && message.contains("stable here only below"), "{message}");
+}

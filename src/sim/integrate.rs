@@ -320,6 +320,15 @@ impl Integrator {
         if let Some(i) = next.x.iter().zip(&next.v).position(|(x, v)| !x.is_finite() || !v.is_finite()) {
             return Err(diverged(format!("vertex {i} has a non-finite position or velocity")));
         }
+        if let Some((i, speed)) =
+            next.v.iter().map(|v| v.length()).enumerate().filter(|&(i, _)| !model.fixed[i]).max_by(|a, b| a.1.total_cmp(&b.1))
+            && speed > model.max_wave_speed
+        {
+            return Err(diverged(format!(
+                "vertex {i} moves at {speed:.3e} m/s, faster than the cloth's fastest in-plane wave ({:.0} m/s)",
+                model.max_wave_speed
+            )));
+        }
         if model.has_membrane() {
             let stretch = model.max_stretch(&next.x);
             if stretch > self.max_stretch {
@@ -353,7 +362,10 @@ impl Integrator {
             }
         }
         timings.forces += lap(&mut clock);
-        if let Some(contact) = &model.contact {
+        // A step that blew up is left for `check` to reject: its paths can span the scene
+        // many times over, and sweeping them for collisions would take forever.
+        let blown_up = s.v.iter().any(|v| !(v.length() <= model.max_wave_speed));
+        if let Some(contact) = model.contact.as_ref().filter(|_| !blown_up) {
             contact.project_explicit(&start, &mut s.x, &mut s.v, &model.fixed);
             self.finish_contact(model, contact, &start, s);
             timings.contact += lap(&mut clock);

@@ -166,6 +166,11 @@ pub struct Model {
     pub edges: Vec<[u32; 2]>,
     /// Props and contact settings; None where the cloth touches nothing.
     pub contact: Option<ContactModel>,
+    /// The fastest in-plane wave, √(E_max/ρ_A) with E_max the steepest slope of the
+    /// tensile curves, m/s (infinite without a membrane). No part of a cloth driven by its
+    /// own elasticity, gravity over the scene's height or the rigs' slow grips moves this
+    /// fast: a vertex that does is a blow-up, even where contact keeps its positions tame.
+    pub max_wave_speed: f64,
 }
 
 /// Rotates a sample-plane vector into the warp frame (x along the warp).
@@ -235,6 +240,11 @@ impl Model {
             motions: vec![Motion::STILL],
             edges: edge_set,
             contact: None,
+            max_wave_speed: if options.membrane {
+                (fabric.tensile_warp.max_slope().max(fabric.tensile_weft.max_slope()) / fabric.areal_density).sqrt()
+            } else {
+                f64::INFINITY
+            },
         };
         if options.bending {
             model.build_bending(&vec![false; n])?;
