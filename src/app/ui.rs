@@ -314,7 +314,7 @@ impl ViewerUi {
             ui.end_row();
             let mut has_bias = bias.is_some();
             if ui.checkbox(&mut has_bias, "bending, bias").on_hover_text("Measured 45° rigidity; off: eq. 3 of the paper").changed() {
-                bias = has_bias.then(|| 0.35 * (bending_warp + bending_weft));
+                bias = has_bias.then_some(0.35 * (bending_warp + bending_weft));
                 changed = true;
             }
             if let Some(b) = &mut bias {

@@ -22,6 +22,9 @@ use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+
+/// A prop's surface as drawn: positions (m) and triangles.
+pub type PropSurface = (Vec<DVec3>, Vec<[u32; 3]>);
 /// What the UI asks of the worker. Commands are handled in the order sent.
 #[derive(Debug, Clone)]
 pub enum Command {
@@ -111,7 +114,7 @@ pub struct Snapshot {
     /// Vertices held by the rig (clamps, grips) or the mouse.
     pub fixed: Vec<bool>,
     /// Surfaces of the scene's props (ground planes excepted): positions (m) and triangles.
-    pub props: Arc<Vec<(Vec<DVec3>, Vec<[u32; 3]>)>>,
+    pub props: Arc<Vec<PropSurface>>,
     /// Height of the highest ground prop, m, if any.
     pub ground_z: Option<f64>,
     /// Per-triangle membrane strain `[ε_warp, ε_weft, γ]` (empty with the membrane off).
@@ -244,7 +247,7 @@ struct WorkerState {
     config: Arc<SceneConfig>,
     triangles: Arc<Vec<[u32; 3]>>,
     rest: Arc<Vec<glam::DVec2>>,
-    props: Arc<Vec<(Vec<DVec3>, Vec<[u32; 3]>)>>,
+    props: Arc<Vec<PropSurface>>,
     ground_z: Option<f64>,
     mailbox: Arc<Mailbox>,
     on_publish: Option<Box<dyn Fn() + Send>>,

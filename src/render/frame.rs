@@ -126,6 +126,14 @@ fn scalar_field(scene: &Scene, map: ColorMap) -> ScalarField {
     ScalarField::from_triangles(map, &per_triangle, &model.triangles, x.len())
 }
 
+/// Axis-aligned bounds of the finite points, or `None` when there are none.
+fn bounds_of<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> Option<(DVec3, DVec3)> {
+    points.filter(|p| p.iter().all(|c| c.is_finite())).fold(None, |acc, p| {
+        let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+        Some(acc.map_or((p, p), |(lo, hi): (DVec3, DVec3)| (lo.min(p), hi.max(p))))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -141,12 +149,4 @@ mod tests {
         assert!(close(frame.cloth_uv[2], [0.01, 0.0]), "{:?}", frame.cloth_uv[2]);
         assert!(frame.floor_z.unwrap() < 0.0);
     }
-}
-
-/// Axis-aligned bounds of the finite points, or `None` when there are none.
-fn bounds_of<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> Option<(DVec3, DVec3)> {
-    points.filter(|p| p.iter().all(|c| c.is_finite())).fold(None, |acc, p| {
-        let p = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
-        Some(acc.map_or((p, p), |(lo, hi): (DVec3, DVec3)| (lo.min(p), hi.max(p))))
-    })
 }

@@ -364,7 +364,7 @@ impl Integrator {
         timings.forces += lap(&mut clock);
         // A step that blew up is left for `check` to reject: its paths can span the scene
         // many times over, and sweeping them for collisions would take forever.
-        let blown_up = s.v.iter().any(|v| !(v.length() <= model.max_wave_speed));
+        let blown_up = s.v.iter().any(|v| v.length().is_nan() || v.length() > model.max_wave_speed);
         if let Some(contact) = model.contact.as_ref().filter(|_| !blown_up) {
             contact.project_explicit(&start, &mut s.x, &mut s.v, &model.fixed);
             self.finish_contact(model, contact, &start, s);
@@ -400,9 +400,9 @@ impl Integrator {
         };
         let t_next = s.time + dt;
         let mut y = inertial.clone();
-        for i in 0..n {
+        for (i, yi) in y.iter_mut().enumerate() {
             if model.fixed[i] {
-                y[i] = model.prescribed_position(i, t_next);
+                *yi = model.prescribed_position(i, t_next);
             }
         }
         let step = ImplicitStep { model, h, anchor: &anchor, inertial: &inertial };

@@ -828,6 +828,8 @@ fn quadratic_gradient_weights(points: &[u32], warp: &[DVec2], midpoint: DVec2, s
 /// but with weights so large that the bending matrix gained eigenvalues a million times too
 /// high (explicit steps 100× too small, stiff Newton systems). The caller then grows the
 /// neighbourhood instead.
+// Index loops are the plain statement of a 6×6 Cholesky solve.
+#[allow(clippy::needless_range_loop)]
 fn invert_spd6(a: [[f64; 6]; 6]) -> Option<[[f64; 6]; 6]> {
     let mut l = [[0.0f64; 6]; 6];
     let largest = (0..6).map(|i| a[i][i]).fold(0.0, f64::max);
