@@ -61,19 +61,19 @@ fn cases(quick: bool) -> Vec<Case> {
     };
     let mut out = vec![
         case("tensile-bias", "tensile-bias", vec![], Some(if quick { 0.5 } else { 6.0 }), Some(8.06)),
-        case("euler-buckling", "euler-buckling", vec![], Some(if quick { 0.2 } else { 2.0 }), Some(1.39)),
+        case("euler-buckling", "euler-buckling", vec![], Some(if quick { 0.2 } else { 8.0 }), Some(1.39)),
         case("shear-buckling", "shear-buckling", vec![], Some(if quick { 0.2 } else { 2.2 }), Some(9.58)),
     ];
     if !quick {
         // The whole drape, to settling: the paper's Fig. 6 scene.
         out.push(case("cusick-drape, to settling", "cusick-drape", vec![], None, Some(9.36)));
     }
-    // The same window for every size, so that their costs compare: the first five 4 ms
+    // The same window for every size, so that their costs compare: the first two 4 ms
     // steps of the lowering (gravity ramps up over 2 s), short enough for 80 000 triangles
-    // to finish in minutes. Whole runs to settling cost about twice as much per simulated
-    // second as this start (README, Speed).
+    // to finish in minutes. Whole runs to settling cost more per simulated second than
+    // this start (README, Speed).
     let sizes: &[(f64, f64)] =
-        if quick { &[(800.0, 0.02), (5000.0, 0.02)] } else { &[(800.0, 0.02), (5000.0, 0.02), (20000.0, 0.02), (80000.0, 0.02)] };
+        if quick { &[(800.0, 0.008), (5000.0, 0.008)] } else { &[(800.0, 0.008), (5000.0, 0.008), (20000.0, 0.008), (80000.0, 0.008)] };
     for &(n, window) in sizes {
         out.push(case(
             &format!("cusick-drape ~{} tri, first {window} s", n as u64),
