@@ -252,12 +252,11 @@ impl Integrator {
         let mut discarded = StepReport::default();
         loop {
             let dt = self.dt;
-            let mut trial = state.clone();
-            let outcome = self.fixed_step(model, &mut trial);
+            let outcome = self.attempt(model, state);
             let smaller = (dt * 0.25).max(adaptive.dt_min);
             let at_floor = dt <= adaptive.dt_min * (1.0 + 1e-9);
             match outcome {
-                Ok(mut report) => {
+                Ok((trial, mut report)) => {
                     let error = (0..trial.x.len())
                         .filter(|&i| !model.fixed[i])
                         .map(|i| 0.5 * dt * (trial.v[i] - state.v[i]).length())
@@ -292,6 +291,13 @@ impl Integrator {
 
     /// One step of `self.dt`. On error `state` is unchanged.
     fn fixed_step(&mut self, model: &Model, state: &mut State) -> Result<StepReport, StepError> {
+        let (next, report) = self.attempt(model, state)?;
+        *state = next;
+        Ok(report)
+    }
+
+    /// One step of `self.dt` from `state`: the state it reaches, or why it was rejected.
+    fn attempt(&mut self, model: &Model, state: &State) -> Result<(State, StepReport), StepError> {
         let mut next = state.clone();
         let report = match self.kind {
             IntegratorKind::SymplecticEuler => {
@@ -311,8 +317,7 @@ impl Integrator {
             }
             return Err(StepError::Diverged { integrator, dt, time, reason });
         }
-        *state = next;
-        Ok(StepReport { dt: self.dt, ..report })
+        Ok((next, StepReport { dt: self.dt, ..report }))
     }
 
     fn check(&self, model: &Model, next: &State, time: f64) -> Result<(), StepError> {
@@ -320,10 +325,7 @@ impl Integrator {
         if let Some(i) = next.x.iter().zip(&next.v).position(|(x, v)| !x.is_finite() || !v.is_finite()) {
             return Err(diverged(format!("vertex {i} has a non-finite position or velocity")));
         }
-        if let Some((i, speed)) =
-            next.v.iter().map(|v| v.length()).enumerate().filter(|&(i, _)| !model.fixed[i]).max_by(|a, b| a.1.total_cmp(&b.1))
-            && speed > model.max_wave_speed
-        {
+        if let Some((i, speed)) = model.outrunning_vertex(&next.v) {
             return Err(diverged(format!(
                 "vertex {i} moves at {speed:.3e} m/s, faster than the cloth's fastest in-plane wave ({:.0} m/s)",
                 model.max_wave_speed
@@ -364,7 +366,7 @@ impl Integrator {
         timings.forces += lap(&mut clock);
         // A step that blew up is left for `check` to reject: its paths can span the scene
         // many times over, and sweeping them for collisions would take forever.
-        let blown_up = s.v.iter().any(|v| v.length().is_nan() || v.length() > model.max_wave_speed);
+        let blown_up = model.outrunning_vertex(&s.v).is_some();
         if let Some(contact) = model.contact.as_ref().filter(|_| !blown_up) {
             contact.project_explicit(&start, &mut s.x, &mut s.v, &model.fixed);
             self.finish_contact(model, contact, &start, s);
@@ -501,7 +503,7 @@ impl Integrator {
         let mut couplings = Vec::new();
         let mut factor: Option<(Preconditioner, usize)> = None;
         let mut last_cg = 0;
-        let (mut previous_norm, mut forcing): (Option<f64>, f64) = (None, 0.1);
+        let mut previous_norm: Option<f64> = None;
         let mut clock = Instant::now();
         let mut timings = StepTimings::default();
         for _ in 0..self.newton.max_iterations {
@@ -551,18 +553,11 @@ impl Integrator {
             let (preconditioner, fresh) = factor.as_mut().expect("built above");
             let cg_tolerance = if self.newton.forcing {
                 let norm = gradient.iter().map(|g| g.length_squared()).sum::<f64>().sqrt();
-                let eta = match previous_norm {
-                    None => 0.1,
-                    Some(before) => {
-                        let eta = 0.9 * (norm / before).powi(2);
-                        // Safeguard: do not tighten faster than the previous term allows.
-                        let floor = 0.9 * forcing * forcing;
-                        if floor > 0.1 { eta.max(floor) } else { eta }
-                    }
-                };
+                // Eisenstat and Walker's safeguard against tightening too fast, 0.9·η²_{k−1},
+                // only acts above 0.1, which this term never exceeds.
+                let eta = previous_norm.map_or(0.1, |before| 0.9 * (norm / before).powi(2));
                 previous_norm = Some(norm);
-                forcing = eta.clamp(self.newton.cg_tolerance, 0.1);
-                forcing
+                eta.clamp(self.newton.cg_tolerance, 0.1)
             } else {
                 self.newton.cg_tolerance
             };

@@ -252,6 +252,18 @@ impl Model {
         Ok(model)
     }
 
+    /// The fastest free vertex of velocities `v`, (index, speed m/s), if it moves faster
+    /// than the cloth's fastest in-plane wave or at no finite speed: a blow-up.
+    pub fn outrunning_vertex(&self, v: &[DVec3]) -> Option<(usize, f64)> {
+        let (i, speed) = v
+            .iter()
+            .map(|v| v.length())
+            .enumerate()
+            .filter(|&(i, _)| !self.fixed[i])
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        (speed.is_nan() || speed > self.max_wave_speed).then_some((i, speed))
+    }
+
     pub fn vertex_count(&self) -> usize {
         self.rest.len()
     }
