@@ -53,15 +53,18 @@ pub fn shadow(x: &[DVec3], triangles: &[[u32; 3]], centre: DVec2, resolution: us
     for k in 0..OUTLINE_BINS {
         let angle = 2.0 * std::f64::consts::PI * k as f64 / OUTLINE_BINS as f64;
         let dir = DVec2::from_angle(angle);
+        // The farthest covered cell along the ray: marching inwards, the first one met (the
+        // ray leaves the square grid once, so the cells outside it are a tail of the ray).
         let mut radius = 0.0;
-        for s in 0..steps {
+        for s in (0..steps).rev() {
             let r = reach * 1.5 * s as f64 / steps as f64;
             let q = (centre + r * dir - origin) / cell;
             if q.x < 0.0 || q.y < 0.0 || q.x >= resolution as f64 || q.y >= resolution as f64 {
-                break;
+                continue;
             }
             if covered[q.y as usize * resolution + q.x as usize] {
                 radius = r;
+                break;
             }
         }
         outline.push((angle, radius));

@@ -459,60 +459,28 @@ impl Model {
     /// geometric stiffness of compressed edges dropped so that it stays positive
     /// semi-definite) into `k`, which must have this model's pattern.
     pub fn assemble_membrane_stiffness(&self, x: &[DVec3], k: &mut BlockCsr) {
+        use rayon::prelude::*;
+        /// Below this many triangles the blocks are added as they are computed; above it
+        /// they are computed on all threads and added afterwards.
+        const PARALLEL_TRIANGLES: usize = 4096;
         k.clear();
         let Some(law) = &self.membrane_law else { return };
-        for tri in &self.rosettes {
-            let (strain, dirs, lengths) = rosette_strain(tri, x);
-            let c = law.tangent(strain);
-            let g = &tri.strain_from_edges;
-            // Material stiffness in edge-strain space: A · Tᵀ C T, scaled by 1/(L_k L_l).
-            let mut ke = [[0.0; 3]; 3];
-            for p in 0..3 {
-                for q in 0..3 {
-                    let mut s = 0.0;
-                    for i in 0..3 {
-                        for j in 0..3 {
-                            s += g[i][p] * c[i][j] * g[j][q];
-                        }
-                    }
-                    ke[p][q] = tri.area * s / (tri.rest_length[p] * tri.rest_length[q]);
+        let add = |k: &mut BlockCsr, tri: &RosetteTriangle, blocks: &[DMat3; 6]| {
+            for (i, &(a, b)) in UPPER_BLOCKS.iter().enumerate() {
+                k.values[tri.slots[a * 3 + b] as usize] += blocks[i];
+                if a != b {
+                    k.values[tri.slots[b * 3 + a] as usize] += blocks[i].transpose();
                 }
             }
-            let tension = edge_tensions(tri, law.stress(strain));
-            // Vertex `v` of the triangle moves edge k's length by sign(k, v) · dirs[k].
-            let sign = |k: usize, v: usize| -> f64 {
-                if v == (k + 2) % 3 {
-                    1.0
-                } else if v == (k + 1) % 3 {
-                    -1.0
-                } else {
-                    0.0
-                }
-            };
-            for a in 0..3 {
-                for b in 0..3 {
-                    let mut block = DMat3::ZERO;
-                    for p in 0..3 {
-                        let sp = sign(p, a);
-                        if sp == 0.0 {
-                            continue;
-                        }
-                        for q in 0..3 {
-                            let sq = sign(q, b);
-                            if sq == 0.0 {
-                                continue;
-                            }
-                            block += outer(dirs[p], dirs[q]) * (sp * sq * ke[p][q]);
-                        }
-                        // Geometric stiffness of a stretched edge: (t/l)(I − uuᵀ).
-                        let sb = sign(p, b);
-                        if tension[p] > 0.0 && sb != 0.0 {
-                            let geo = (DMat3::IDENTITY - outer(dirs[p], dirs[p])) * (tension[p] / lengths[p]);
-                            block += geo * (sp * sb);
-                        }
-                    }
-                    k.values[tri.slots[a * 3 + b] as usize] += block;
-                }
+        };
+        if self.rosettes.len() < PARALLEL_TRIANGLES {
+            for tri in &self.rosettes {
+                add(k, tri, &triangle_stiffness(tri, law, x));
+            }
+        } else {
+            let blocks: Vec<[DMat3; 6]> = self.rosettes.par_iter().map(|tri| triangle_stiffness(tri, law, x)).collect();
+            for (tri, b) in self.rosettes.iter().zip(&blocks) {
+                add(k, tri, b);
             }
         }
     }
@@ -613,6 +581,64 @@ impl Model {
     pub fn max_membrane_stiffness(&self) -> f64 {
         self.membrane_law.as_ref().map_or(0.0, |l| l.max_stiffness())
     }
+}
+
+/// The vertex pairs (a, b), a ≤ b, of a triangle's upper stiffness blocks.
+const UPPER_BLOCKS: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+/// One triangle's membrane stiffness blocks (a, b) in [`UPPER_BLOCKS`] order: the Hessian of
+/// its energy with the geometric stiffness of compressed edges dropped.
+///
+/// With l_p the edge lengths and u_p their directions, ∂l_p/∂x_a = s_pa u_p where vertex a
+/// ends edge a+1 (s = +1) and starts edge a+2 (s = −1). The material part of block (a, b)
+/// is Σ_pq s_pa s_qb K_pq u_p u_qᵀ, K = A·GᵀCG/(L_p L_q) in edge-strain space; a stretched
+/// edge adds its geometric stiffness (t/l)(I − u uᵀ) with signs s_pa s_pb.
+fn triangle_stiffness(tri: &RosetteTriangle, law: &MembraneLaw, x: &[DVec3]) -> [DMat3; 6] {
+    let (strain, dirs, lengths) = rosette_strain(tri, x);
+    let c = law.tangent(strain);
+    let g = &tri.strain_from_edges;
+    let mut ke = [[0.0; 3]; 3];
+    for p in 0..3 {
+        for q in p..3 {
+            let mut s = 0.0;
+            for i in 0..3 {
+                for j in 0..3 {
+                    s += g[i][p] * c[i][j] * g[j][q];
+                }
+            }
+            ke[p][q] = tri.area * s / (tri.rest_length[p] * tri.rest_length[q]);
+            ke[q][p] = ke[p][q];
+        }
+    }
+    let tension = edge_tensions(tri, law.stress(strain));
+    let geometric: [DMat3; 3] = [0, 1, 2].map(|p| {
+        if tension[p] > 0.0 { (DMat3::IDENTITY - outer(dirs[p], dirs[p])) * (tension[p] / lengths[p]) } else { DMat3::ZERO }
+    });
+    // M_pq = K_pq u_p u_qᵀ; M_qp = M_pqᵀ.
+    let mut m = [[DMat3::ZERO; 3]; 3];
+    for p in 0..3 {
+        for q in p..3 {
+            m[p][q] = outer(dirs[p], dirs[q]) * ke[p][q];
+            m[q][p] = m[p][q].transpose();
+        }
+    }
+    let edges_of = |a: usize| [((a + 1) % 3, 1.0), ((a + 2) % 3, -1.0)];
+    UPPER_BLOCKS.map(|(a, b)| {
+        let mut block = DMat3::ZERO;
+        for (p, sp) in edges_of(a) {
+            for (q, sq) in edges_of(b) {
+                block += m[p][q] * (sp * sq);
+            }
+        }
+        if a == b {
+            block += geometric[(a + 1) % 3] + geometric[(a + 2) % 3];
+        } else {
+            // The edge joining a and b is the one opposite the third vertex; it starts at
+            // one and ends at the other.
+            block -= geometric[3 - a - b];
+        }
+        block
+    })
 }
 
 fn sorted_edge(a: u32, b: u32) -> [u32; 2] {

@@ -330,6 +330,10 @@ impl ContactModel {
             let lo = corners.iter().fold(DVec3::INFINITY, |a, &i| a.min(start[i]).min(predicted[i])) - DVec3::splat(delta);
             let hi = corners.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(start[i]).max(predicted[i])) + DVec3::splat(delta);
             let tri_motion = corners.iter().map(|&i| motion(i)).fold(0.0, f64::max);
+            // The triangle's box at the start: a vertex farther from it than the reach
+            // below is farther from the triangle too.
+            let start_lo = corners.iter().fold(DVec3::INFINITY, |a, &i| a.min(start[i]));
+            let start_hi = corners.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(start[i]));
             seen.clear();
             hash.query_box(lo, hi, |v| {
                 if !t.contains(&v) && !seen.contains(&v) {
@@ -339,6 +343,10 @@ impl ContactModel {
             for &v in &seen {
                 let vi = v as usize;
                 if fixed[vi] && corners.iter().all(|&i| fixed[i]) {
+                    continue;
+                }
+                let reach = delta + motion(vi) + tri_motion;
+                if !boxes_overlap((start[vi], start[vi]), (start_lo, start_hi), reach) {
                     continue;
                 }
                 let (q, _) = closest_point_triangle(start[vi], start[corners[0]], start[corners[1]], start[corners[2]]);
@@ -370,9 +378,13 @@ impl ContactModel {
                 if c == a || c == b || d == a || d == b || (fixed[a] && fixed[b] && fixed[c] && fixed[d]) {
                     continue;
                 }
+                let reach = delta + motion(a).max(motion(b)) + motion(c).max(motion(d));
+                let segment_box = |p: usize, q: usize| (start[p].min(start[q]), start[p].max(start[q]));
+                if !boxes_overlap(segment_box(a, b), segment_box(c, d), reach) {
+                    continue;
+                }
                 let (sa, tb) = closest_points_segments(start[a], start[b], start[c], start[d]);
                 let gap = (start[a].lerp(start[b], sa) - start[c].lerp(start[d], tb)).length();
-                let reach = delta + motion(a).max(motion(b)) + motion(c).max(motion(d));
                 if gap < reach {
                     let m = 0.25 * (mass[a] + mass[b] + mass[c] + mass[d]);
                     pairs.push(SelfPair {
@@ -444,6 +456,11 @@ impl ContactModel {
     }
 }
 
+/// Whether two boxes come within `margin` of each other.
+fn boxes_overlap(a: (DVec3, DVec3), b: (DVec3, DVec3), margin: f64) -> bool {
+    (a.0 - DVec3::splat(margin)).cmple(b.1).all() && (a.1 + DVec3::splat(margin)).cmpge(b.0).all()
+}
+
 fn mean_edge(x: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
     let sum: f64 = triangles.iter().take(64).map(|t| (x[t[1] as usize] - x[t[0] as usize]).length()).sum();
     sum / triangles.len().clamp(1, 64) as f64
@@ -476,6 +493,10 @@ fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges:
             if !moving(p) && c.iter().all(|&i| !moving(i)) {
                 continue;
             }
+            // The hash's cells are an edge long; the paths of a step are far shorter.
+            if !boxes_overlap(swept(p), (lo, hi), 0.0) {
+                continue;
+            }
             let path = |i: usize| [start[i], end[i]];
             if vertex_triangle_ccd(path(p), path(c[0]), path(c[1]), path(c[2]), eps).is_some() {
                 found.push(vec![v, t[0], t[1], t[2]]);
@@ -505,6 +526,10 @@ fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges:
                 continue;
             }
             if !moving(a) && !moving(b) && !moving(c) && !moving(d) {
+                continue;
+            }
+            let other = (swept(c).0.min(swept(d).0), swept(c).1.max(swept(d).1));
+            if !boxes_overlap((lo, hi), other, eps) {
                 continue;
             }
             let path = |i: usize| [start[i], end[i]];
