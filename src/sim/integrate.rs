@@ -105,11 +105,15 @@ pub struct NewtonSettings {
     /// from the solution, solve their linear systems only to η_k = 0.9(|g_k|/|g_{k−1}|)²
     /// (at most 0.1, at least `cg_tolerance`) instead of `cg_tolerance`.
     pub forcing: bool,
+    /// Newton starts from x_n + Δt(2v_n − v_{n−1}), where the last step's acceleration would
+    /// carry the cloth, when Φ is lower there than at the inertial guess (the solution is
+    /// the same; only the start moves closer to it when the motion is smooth).
+    pub warm_start: bool,
 }
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { max_iterations: 30, tolerance: 1e-5, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true }
+        Self { max_iterations: 30, tolerance: 1e-5, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true, warm_start: true }
     }
 }
 
@@ -401,13 +405,24 @@ impl Integrator {
             _ => (dt, s.x.clone(), (0..n).map(|i| s.x[i] + dt * s.v[i]).collect()),
         };
         let t_next = s.time + dt;
-        let mut y = inertial.clone();
-        for (i, yi) in y.iter_mut().enumerate() {
-            if model.fixed[i] {
-                *yi = model.prescribed_position(i, t_next);
+        let step = ImplicitStep { model, h, anchor: &anchor, inertial: &inertial };
+        let prescribe = |mut y: Vec<DVec3>| {
+            for (i, yi) in y.iter_mut().enumerate() {
+                if model.fixed[i] {
+                    *yi = model.prescribed_position(i, t_next);
+                }
+            }
+            y
+        };
+        let mut y = prescribe(inertial.clone());
+        if let (Some((_, vp)), true) = (&s.previous, self.newton.warm_start) {
+            // Where the last step's acceleration would carry the cloth; kept only if it is
+            // the better start (it is not when the motion reverses, as in a vibration).
+            let extrapolated = prescribe((0..n).map(|i| s.x[i] + dt * (2.0 * s.v[i] - vp[i])).collect());
+            if step.potential(&extrapolated) < step.potential(&y) {
+                y = extrapolated;
             }
         }
-        let step = ImplicitStep { model, h, anchor: &anchor, inertial: &inertial };
         let mut report = StepReport::default();
         let mut step_contacts = None;
         match &model.contact {
@@ -479,17 +494,7 @@ impl Integrator {
         let n = y.len();
         let zeta = model.options.damping;
         let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
-        let objective = |y: &[DVec3]| -> f64 {
-            let mut inertia = 0.0;
-            for i in 0..n {
-                if !model.fixed[i] {
-                    let m = model.mass[i];
-                    inertia += m / (2.0 * h * h) * (y[i] - inertial[i]).length_squared()
-                        + zeta * m / (2.0 * h) * (y[i] - anchor[i]).length_squared();
-                }
-            }
-            inertia + model.potential_energy(y) + contacts.map_or(0.0, |c| c.energy(y, anchor))
-        };
+        let objective = |y: &[DVec3]| -> f64 { step.potential(y) + contacts.map_or(0.0, |c| c.energy(y, anchor)) };
         let mut stiffness = model.stiffness_matrix();
         let mut gradient = vec![DVec3::ZERO; n];
         let mut direction = vec![DVec3::ZERO; n];
@@ -636,4 +641,21 @@ struct ImplicitStep<'a> {
     h: f64,
     anchor: &'a [DVec3],
     inertial: &'a [DVec3],
+}
+
+impl ImplicitStep<'_> {
+    /// The incremental potential Φ at `y` without contact.
+    fn potential(&self, y: &[DVec3]) -> f64 {
+        let (model, h) = (self.model, self.h);
+        let zeta = model.options.damping;
+        let mut inertia = 0.0;
+        for i in 0..y.len() {
+            if !model.fixed[i] {
+                let m = model.mass[i];
+                inertia += m / (2.0 * h * h) * (y[i] - self.inertial[i]).length_squared()
+                    + zeta * m / (2.0 * h) * (y[i] - self.anchor[i]).length_squared();
+            }
+        }
+        inertia + model.potential_energy(y)
+    }
 }
