@@ -88,7 +88,7 @@ impl Scene {
                 self_collision: k.self_collision,
                 self_thickness: k.self_thickness.unwrap_or(k.thickness.min(0.2 * model.mean_edge_length)),
                 stiffness: k.stiffness,
-                ..ContactSettings::default()
+                slip_speed: k.slip_speed,
             };
             model.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
         }

@@ -109,11 +109,23 @@ pub struct ContactSection {
     pub self_thickness: Option<f64>,
     /// Contact penalty stiffness as a multiple of m/Δt² per vertex (implicit solvers).
     pub stiffness: f64,
+    /// Tangential speed below which friction sticks, m/s. Smoothed (IPC) friction lets a
+    /// sticking cloth under a sideways pull F creep at slip_speed·F/(μN): keep it well
+    /// below the speeds a scene should resolve, and below its settle speed.
+    pub slip_speed: f64,
 }
 
 impl Default for ContactSection {
     fn default() -> Self {
-        Self { thickness: 0.002, friction_static: 0.5, friction_kinetic: 0.4, self_collision: false, self_thickness: None, stiffness: 100.0 }
+        Self {
+            thickness: 0.002,
+            friction_static: 0.5,
+            friction_kinetic: 0.4,
+            self_collision: false,
+            self_thickness: None,
+            stiffness: 100.0,
+            slip_speed: 1e-3,
+        }
     }
 }
 
