@@ -9,7 +9,7 @@
 //! fixed vertices) is the model's for the whole run, so the ordering and symbolic analysis
 //! are done once and each factorisation is numeric only.
 
-use crate::sim::sparse::SystemMatrix;
+use crate::sim::sparse::{SystemMatrix, merge_rows};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -55,36 +55,13 @@ impl DirectPattern {
         let mut col_ptr = vec![0u32];
         let mut row_idx = Vec::new();
         let mut sources = Vec::new();
-        let mut neighbours: Vec<(u32, u32, u32)> = Vec::new();
+        let mut neighbours: Vec<(u32, usize, usize)> = Vec::new();
         for v in 0..n {
             neighbours.clear();
             if !a.fixed[v] {
                 // Columns u ≥ v of row v in either pattern, with their slots.
-                let (kc, _) = k.row(v);
-                let k_start = k.slot(v as u32, kc[0]);
-                let (qc, _) = a.bending.map_or((&[][..], &[][..]), |q| q.row(v));
-                let q_start = a.bending.map_or(0, |q| if qc.is_empty() { 0 } else { q.slot(v as u32, qc[0]) });
-                let (mut i, mut j) = (0, 0);
-                while i < kc.len() || j < qc.len() {
-                    let u = match (kc.get(i), qc.get(j)) {
-                        (Some(&x), Some(&y)) => x.min(y),
-                        (Some(&x), None) => x,
-                        (None, Some(&y)) => y,
-                        (None, None) => unreachable!(),
-                    };
-                    let mut entry = (u, u32::MAX, u32::MAX);
-                    if kc.get(i) == Some(&u) {
-                        entry.1 = (k_start + i) as u32;
-                        i += 1;
-                    }
-                    if qc.get(j) == Some(&u) {
-                        entry.2 = (q_start + j) as u32;
-                        j += 1;
-                    }
-                    if u as usize >= v && !a.fixed[u as usize] {
-                        neighbours.push(entry);
-                    }
-                }
+                let q_row = a.bending.map_or((&[][..], 0), |q| q.row_pattern(v));
+                merge_rows(k.row_pattern(v), q_row, |u| u as usize >= v && !a.fixed[u as usize], &mut neighbours);
             }
             for col_c in 0..3u8 {
                 let col = 3 * v + col_c as usize;
@@ -101,11 +78,12 @@ impl DirectPattern {
                             // Entry (3u + row_c, 3v + col_c) = A_uv[row_c][col_c] = A_vu[col_c][row_c].
                             let diagonal_component = row_c == col_c;
                             row_idx.push(row as u32);
+                            let slot = |s: usize| if s == usize::MAX { u32::MAX } else { s as u32 };
                             sources.push(Source {
-                                block,
+                                block: slot(block),
                                 a: col_c,
                                 b: row_c,
-                                bending: if diagonal_component { bending } else { u32::MAX },
+                                bending: if diagonal_component { slot(bending) } else { u32::MAX },
                                 mass: if diagonal_component && u as usize == v { v as u32 } else { u32::MAX },
                             });
                         }

@@ -16,9 +16,9 @@ use crate::sim::contact::{ContactModel, ContactStats, StepContacts};
 use crate::sim::model::Model;
 use crate::sim::direct::DirectPattern;
 use crate::sim::sparse::{Preconditioner, SystemMatrix, pcg};
-use std::sync::Arc;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 use std::time::Instant;
 use thiserror::Error;
 

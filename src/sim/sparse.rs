@@ -106,10 +106,10 @@ impl BlockCsr {
         self.row_start.len() - 1
     }
 
-    /// Columns and blocks of one row.
-    pub fn row(&self, row: usize) -> (&[u32], &[DMat3]) {
+    /// Columns of one row and the slot of its first entry.
+    pub fn row_pattern(&self, row: usize) -> (&[u32], usize) {
         let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
-        (&self.cols[s..e], &self.values[s..e])
+        (&self.cols[s..e], s)
     }
 }
 
@@ -140,10 +140,10 @@ impl ScalarCsr {
         self.value(row, row)
     }
 
-    /// Columns and values of one row.
-    pub fn row(&self, row: usize) -> (&[u32], &[f64]) {
+    /// Columns of one row and the slot of its first entry.
+    pub fn row_pattern(&self, row: usize) -> (&[u32], usize) {
         let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
-        (&self.cols[s..e], &self.values[s..e])
+        (&self.cols[s..e], s)
     }
 
     /// Entry (row, col), zero where the pattern has none.
@@ -315,35 +315,31 @@ struct FactorPart {
     block_products: usize,
 }
 
-/// Columns below the diagonal of one row of the union of two sorted patterns, with the
-/// slot each came from in either (or `usize::MAX`).
-fn merge_lower(row: usize, a: (&[u32], usize), b: (&[u32], usize), out: &mut Vec<(u32, usize, usize)>) {
+/// The union of two rows' sorted column lists (`(columns, slot of the first)` each), as
+/// (column, slot in the first or `usize::MAX`, slot in the second or `usize::MAX`), keeping
+/// the columns `keep` accepts.
+pub(crate) fn merge_rows(a: (&[u32], usize), b: (&[u32], usize), keep: impl Fn(u32) -> bool, out: &mut Vec<(u32, usize, usize)>) {
     out.clear();
-    let (ac, a0) = a;
-    let (bc, b0) = b;
+    let ((ac, a0), (bc, b0)) = (a, b);
     let (mut i, mut j) = (0, 0);
-    loop {
-        let ca = ac.get(i).copied().filter(|&c| (c as usize) < row);
-        let cb = bc.get(j).copied().filter(|&c| (c as usize) < row);
-        match (ca, cb) {
-            (None, None) => break,
-            (Some(x), Some(y)) if x == y => {
-                out.push((x, a0 + i, b0 + j));
-                i += 1;
-                j += 1;
-            }
-            (Some(x), Some(y)) if x < y => {
-                out.push((x, a0 + i, usize::MAX));
-                i += 1;
-            }
-            (Some(x), None) => {
-                out.push((x, a0 + i, usize::MAX));
-                i += 1;
-            }
-            (_, Some(y)) => {
-                out.push((y, usize::MAX, b0 + j));
-                j += 1;
-            }
+    while i < ac.len() || j < bc.len() {
+        let col = match (ac.get(i), bc.get(j)) {
+            (Some(&x), Some(&y)) => x.min(y),
+            (Some(&x), None) => x,
+            (None, Some(&y)) => y,
+            (None, None) => unreachable!("the loop runs while either has columns"),
+        };
+        let mut entry = (col, usize::MAX, usize::MAX);
+        if ac.get(i) == Some(&col) {
+            entry.1 = a0 + i;
+            i += 1;
+        }
+        if bc.get(j) == Some(&col) {
+            entry.2 = b0 + j;
+            j += 1;
+        }
+        if keep(col) {
+            out.push(entry);
         }
     }
 }
@@ -394,7 +390,6 @@ impl FactorPart {
     /// Factors rows and columns `lo..hi` of A + shift·diag(A).
     fn new(a: &SystemMatrix, shift: f64, lo: usize, hi: usize) -> Option<Self> {
         let k = a.stiffness;
-        let empty = (&[][..], 0);
         let rows = hi - lo;
         let mut row_start = Vec::with_capacity(rows + 1);
         let mut cols: Vec<u32> = Vec::new();
@@ -410,16 +405,11 @@ impl FactorPart {
         for row in lo..hi {
             let start = cols.len();
             if !a.fixed[row] {
-                let (ks, ke) = (k.row_start[row] as usize, k.row_start[row + 1] as usize);
-                let q_part = a.bending.map_or(empty, |q| {
-                    let (s, e) = (q.row_start[row] as usize, q.row_start[row + 1] as usize);
-                    (&q.cols[s..e], s)
-                });
-                merge_lower(row, (&k.cols[ks..ke], ks), q_part, &mut merged);
+                let q_row = a.bending.map_or((&[][..], 0), |q| q.row_pattern(row));
+                // The strictly lower part within this factor's rows, fixed vertices left out.
+                let keep = |col: u32| (lo..row).contains(&(col as usize)) && !a.fixed[col as usize];
+                merge_rows(k.row_pattern(row), q_row, keep, &mut merged);
                 for &(col, k_slot, q_slot) in &merged {
-                    if (col as usize) < lo || a.fixed[col as usize] {
-                        continue;
-                    }
                     let mut block = if k_slot == usize::MAX { DMat3::ZERO } else { k.values[k_slot] };
                     if q_slot != usize::MAX {
                         block += DMat3::from_diagonal(DVec3::splat(a.bending.expect("merged from it").values[q_slot]));
