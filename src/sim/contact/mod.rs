@@ -350,7 +350,7 @@ impl ContactModel {
                     continue;
                 }
                 let (q, _) = closest_point_triangle(start[vi], start[corners[0]], start[corners[1]], start[corners[2]]);
-                if (q - start[vi]).length() < delta + motion(vi) + tri_motion {
+                if (q - start[vi]).length() < reach {
                     let m = 0.25 * (mass[vi] + corners.iter().map(|&i| mass[i]).sum::<f64>());
                     pairs.push(SelfPair { vertices: [v, t[0], t[1], t[2]], edge_edge: false, stiffness: self.settings.stiffness * m / (h * h) });
                 }
