@@ -27,36 +27,48 @@ pub fn shadow(x: &[DVec3], triangles: &[[u32; 3]], centre: DVec2, resolution: us
     let mut covered = vec![false; resolution * resolution];
     for t in triangles {
         let p = t.map(|i| (x[i as usize].truncate() - origin) / cell);
-        let lo = p[0].min(p[1]).min(p[2]).floor().max(DVec2::ZERO);
-        let hi = p[0].max(p[1]).max(p[2]).ceil().min(DVec2::splat(resolution as f64 - 1.0));
-        let area2 = (p[1] - p[0]).perp_dot(p[2] - p[0]);
-        if area2.abs() < 1e-14 {
+        if (p[1] - p[0]).perp_dot(p[2] - p[0]).abs() < 1e-14 {
             continue;
         }
-        for j in lo.y as usize..=hi.y as usize {
-            for i in lo.x as usize..=hi.x as usize {
-                // Cell centres inside the triangle (edge functions, either orientation).
-                let c = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
-                let w0 = (p[1] - c).perp_dot(p[2] - c);
-                let w1 = (p[2] - c).perp_dot(p[0] - c);
-                let w2 = (p[0] - c).perp_dot(p[1] - c);
-                let inside = if area2 > 0.0 { w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0 } else { w0 <= 0.0 && w1 <= 0.0 && w2 <= 0.0 };
-                if inside {
-                    covered[j * resolution + i] = true;
+        // Row by row, the cells whose centres lie between the triangle's edges.
+        let lo = (p[0].y.min(p[1].y).min(p[2].y) - 0.5).ceil().max(0.0) as usize;
+        let hi = (p[0].y.max(p[1].y).max(p[2].y) - 0.5).floor().min(resolution as f64 - 1.0);
+        if hi < 0.0 {
+            continue;
+        }
+        for j in lo..=hi as usize {
+            let y = j as f64 + 0.5;
+            let (mut left, mut right) = (f64::INFINITY, f64::NEG_INFINITY);
+            for k in 0..3 {
+                let (a, b) = (p[k], p[(k + 1) % 3]);
+                if (a.y <= y && y <= b.y) || (b.y <= y && y <= a.y) {
+                    let x = if a.y == b.y { a.x.min(b.x) } else { a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x) };
+                    let x_other = if a.y == b.y { a.x.max(b.x) } else { x };
+                    left = left.min(x);
+                    right = right.max(x_other);
                 }
+            }
+            let first = (left - 0.5).ceil().max(0.0);
+            let last = (right - 0.5).floor().min(resolution as f64 - 1.0);
+            if first <= last {
+                covered[j * resolution + first as usize..=j * resolution + last as usize].fill(true);
             }
         }
     }
     let area = covered.iter().filter(|&&c| c).count() as f64 * cell * cell;
     let mut outline = Vec::with_capacity(OUTLINE_BINS);
     let steps = 2 * resolution;
+    // A covered cell's centre lies in a triangle, so within the farthest vertex's distance;
+    // a ray sample in it is within a cell of that. Samples beyond are skipped (same outline).
+    let farthest = x.iter().map(|p| (p.truncate() - centre).length()).fold(0.0, f64::max) + cell;
+    let first = ((farthest / (reach * 1.5) * steps as f64).ceil() as usize).min(steps);
     for k in 0..OUTLINE_BINS {
         let angle = 2.0 * std::f64::consts::PI * k as f64 / OUTLINE_BINS as f64;
         let dir = DVec2::from_angle(angle);
         // The farthest covered cell along the ray: marching inwards, the first one met (the
         // ray leaves the square grid once, so the cells outside it are a tail of the ray).
         let mut radius = 0.0;
-        for s in (0..steps).rev() {
+        for s in (0..first).rev() {
             let r = reach * 1.5 * s as f64 / steps as f64;
             let q = (centre + r * dir - origin) / cell;
             if q.x < 0.0 || q.y < 0.0 || q.x >= resolution as f64 || q.y >= resolution as f64 {
@@ -160,6 +172,31 @@ mod tests {
         t.extend(t2.iter().map(|tri| tri.map(|i| i + offset)));
         let s = shadow(&x, &t, DVec2::ZERO, 1024);
         assert!((s.area / (std::f64::consts::PI * 0.01) - 1.0).abs() < 3e-3);
+    }
+
+    #[test]
+    fn scanline_shadow_covers_the_cells_whose_centres_are_inside() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        let resolution = 64;
+        for _ in 0..200 {
+            // One random triangle and the square's corners, which fix the grid to [-1, 1]².
+            let mut x: Vec<DVec3> = (0..3).map(|_| DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 0.0)).collect();
+            x.extend([DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 0.0)]);
+            let s = shadow(&x, &[[0, 1, 2]], DVec2::ZERO, resolution);
+            let reach = 1.001 + 1e-9;
+            let cell = 2.0 * reach / resolution as f64;
+            // Count the cell centres inside by the sign of the three edge functions.
+            let p = [0, 1, 2].map(|i| x[i].truncate());
+            let inside = |c: DVec2| {
+                let w = [0, 1, 2].map(|k| (p[(k + 1) % 3] - c).perp_dot(p[(k + 2) % 3] - c));
+                w.iter().all(|&w| w >= 0.0) || w.iter().all(|&w| w <= 0.0)
+            };
+            let count = (0..resolution * resolution)
+                .filter(|k| inside(DVec2::splat(-reach) + cell * DVec2::new((k % resolution) as f64 + 0.5, (k / resolution) as f64 + 0.5)))
+                .count();
+            assert_eq!((s.area / (cell * cell)).round() as usize, count, "triangle {p:?}");
+        }
     }
 
     #[test]

@@ -13,7 +13,7 @@
 //! it was and the error names the integrator, Δt and time.
 
 use crate::sim::contact::{ContactModel, ContactStats, StepContacts};
-use crate::sim::model::Model;
+use crate::sim::model::{CompressedEdges, Model};
 use crate::sim::direct::DirectPattern;
 use crate::sim::sparse::{Preconditioner, SystemMatrix, pcg};
 use glam::DVec3;
@@ -540,8 +540,13 @@ impl Integrator {
         let n = y.len();
         let zeta = model.options.damping;
         let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
+        // Compressed edges may take back up to this share of each vertex's inertia in
+        // Newton's matrix: it stays positive definite, and Newton converges quadratically
+        // where the cloth buckles unless the compression outweighs inertia.
+        let softening: Vec<f64> = mass_diagonal.iter().zip(&model.fixed).map(|(&d, &f)| if f { f64::INFINITY } else { SOFTENING_SHARE * d }).collect();
         let objective = |y: &[DVec3]| -> f64 { step.potential(y) + contacts.map_or(0.0, |c| c.energy(y, anchor)) };
         let mut stiffness = model.stiffness_matrix();
+        let mut bounded = model.stiffness_matrix();
         let mut gradient = vec![DVec3::ZERO; n];
         let mut direction = vec![DVec3::ZERO; n];
         let mut trial = y.clone();
@@ -576,30 +581,44 @@ impl Integrator {
                 }
                 timings.contact += lap(&mut clock);
             }
-            model.assemble_membrane_stiffness(y, &mut stiffness);
             let bending = model.bending_newton_matrix(y);
-            timings.forces += lap(&mut clock);
+            let rhs: Vec<DVec3> = gradient.iter().map(|g| -*g).collect();
+            let cg_tolerance = if self.newton.forcing {
+                let norm = gradient.iter().map(|g| g.length_squared()).sum::<f64>().sqrt();
+                // Eisenstat and Walker's safeguard against tightening too fast, 0.9·η²_{k−1},
+                // only acts above 0.1, which this term never exceeds.
+                let eta = previous_norm.map_or(0.1, |before| 0.9 * (norm / before).powi(2));
+                previous_norm = Some(norm);
+                eta.clamp(self.newton.cg_tolerance, 0.1)
+            } else {
+                self.newton.cg_tolerance
+            };
+            // Newton's matrix takes the exact Hessian of the compressed edges: a buckling
+            // cloth's softening is what makes Newton converge quadratically. Where it
+            // outweighs inertia and bending the matrix is indefinite, and CG meets a direction
+            // of negative curvature or returns no descent: the solve is then repeated with
+            // the softening bounded so that the matrix stays positive definite. Preconditioners
+            // are made from the bounded matrix, which incomplete factors break down on less.
             if let Some(c) = contacts {
-                c.add_hessian(y, anchor, &mut stiffness);
                 couplings.clear();
                 c.couplings(y, &mut couplings);
                 timings.contact += lap(&mut clock);
             }
-            let system = SystemMatrix {
-                mass_diagonal: &mass_diagonal,
-                stiffness: &stiffness,
-                bending: bending.as_deref(),
-                fixed: &model.fixed,
-                couplings: &couplings,
-            };
-            let rhs: Vec<DVec3> = gradient.iter().map(|g| -*g).collect();
-            // A factor serves later iterations, and later steps: the matrix changes little
-            // from one to the next, and a factorisation costs several CG iterations. It is
-            // rebuilt once the iterations it has cost beyond what it took when new add up to
-            // what building it cost (the rent-or-buy rule: never more than twice the best
-            // choice made in hindsight).
             let stale = self.preconditioner.as_ref().is_none_or(|p| p.size != n || p.excess >= p.preconditioner.cost_in_iterations());
+            let mut bounded_ready = false;
             if stale {
+                model.assemble_membrane_stiffness_within(y, &mut bounded, CompressedEdges::Within(&softening));
+                if let Some(c) = contacts {
+                    c.add_hessian(y, anchor, &mut bounded);
+                }
+                bounded_ready = true;
+                timings.forces += lap(&mut clock);
+                let system = SystemMatrix { mass_diagonal: &mass_diagonal, stiffness: &bounded, bending: bending.as_deref(), fixed: &model.fixed, couplings: &couplings };
+                // A factor serves later iterations, and later steps: the matrix changes
+                // little from one to the next, and a factorisation costs several CG
+                // iterations. It is rebuilt once the iterations it has cost beyond what it
+                // took when new add up to what building it cost (the rent-or-buy rule: never
+                // more than twice the best choice made in hindsight).
                 let preconditioner = if self.newton.preconditioner.complete_factor(n) {
                     if self.direct_pattern.as_ref().is_none_or(|p| !p.fits(&system)) {
                         self.direct_pattern = DirectPattern::new(&system).map(Arc::new);
@@ -612,24 +631,36 @@ impl Integrator {
                     system.preconditioner()
                 };
                 self.preconditioner = Some(CachedPreconditioner { size: n, preconditioner, fresh_rate: None, excess: 0.0 });
+                timings.solve += lap(&mut clock);
             }
             let cached = self.preconditioner.as_mut().expect("built above");
-            let cg_tolerance = if self.newton.forcing {
-                let norm = gradient.iter().map(|g| g.length_squared()).sum::<f64>().sqrt();
-                // Eisenstat and Walker's safeguard against tightening too fast, 0.9·η²_{k−1},
-                // only acts above 0.1, which this term never exceeds.
-                let eta = previous_norm.map_or(0.1, |before| 0.9 * (norm / before).powi(2));
-                previous_norm = Some(norm);
-                eta.clamp(self.newton.cg_tolerance, 0.1)
-            } else {
-                self.newton.cg_tolerance
-            };
-            let cg = pcg(&system, &cached.preconditioner, &rhs, &mut direction, cg_tolerance, self.newton.cg_max_iterations);
+            model.assemble_membrane_stiffness_within(y, &mut stiffness, CompressedEdges::Exact);
+            if let Some(c) = contacts {
+                c.add_hessian(y, anchor, &mut stiffness);
+            }
+            timings.forces += lap(&mut clock);
+            let system = SystemMatrix { mass_diagonal: &mass_diagonal, stiffness: &stiffness, bending: bending.as_deref(), fixed: &model.fixed, couplings: &couplings };
+            let mut cg = pcg(&system, &cached.preconditioner, &rhs, &mut direction, cg_tolerance, self.newton.cg_max_iterations);
+            report.cg_iterations += cg.iterations;
+            timings.solve += lap(&mut clock);
+            let descent = gradient.iter().zip(&direction).map(|(g, d)| g.dot(*d)).sum::<f64>() < 0.0;
+            if cg.negative_curvature || !descent {
+                if !bounded_ready {
+                    model.assemble_membrane_stiffness_within(y, &mut bounded, CompressedEdges::Within(&softening));
+                    if let Some(c) = contacts {
+                        c.add_hessian(y, anchor, &mut bounded);
+                    }
+                    timings.forces += lap(&mut clock);
+                }
+                let system = SystemMatrix { mass_diagonal: &mass_diagonal, stiffness: &bounded, bending: bending.as_deref(), fixed: &model.fixed, couplings: &couplings };
+                cg = pcg(&system, &cached.preconditioner, &rhs, &mut direction, cg_tolerance, self.newton.cg_max_iterations);
+                report.cg_iterations += cg.iterations;
+                timings.solve += lap(&mut clock);
+            }
             // Iterations per e-fold of residual reduction: comparable across tolerances.
             let efolds = (-cg.relative_residual.max(1e-16).ln()).max(1.0);
             let fresh_rate = *cached.fresh_rate.get_or_insert(cg.iterations as f64 / efolds);
             cached.excess += (cg.iterations as f64 - fresh_rate * efolds).max(0.0);
-            timings.solve += lap(&mut clock);
             if all_free {
                 // The elastic Hessian annihilates translations, so adding a constant c to d
                 // changes only the mass term of H d. Choosing c so that Σ M (d + c) = −Σ g
@@ -643,7 +674,6 @@ impl Integrator {
                 let shift = -residual / mass_sum;
                 direction.iter_mut().for_each(|d| *d += shift);
             }
-            report.cg_iterations += cg.iterations;
             report.newton_iterations += 1;
             let slope: f64 = gradient.iter().zip(&direction).map(|(g, d)| g.dot(*d)).sum();
             if slope >= 0.0 {
@@ -690,6 +720,10 @@ impl Integrator {
         report.timings += timings;
     }
 }
+
+/// The share of inertia (m/h² + ζm/h) that compressed edges' negative geometric stiffness
+/// may take in Newton's matrix, which keeps at least 1 − SOFTENING_SHARE of it.
+const SOFTENING_SHARE: f64 = 0.9;
 
 /// A preconditioner with what it was built for and how quick it made CG when new.
 struct CachedPreconditioner {

@@ -503,6 +503,9 @@ fn positive_definite(m: &DMat3) -> bool {
 pub struct CgReport {
     pub iterations: usize,
     pub relative_residual: f64,
+    /// The matrix showed a direction of non-positive curvature (it is not positive
+    /// definite); the solve stopped there.
+    pub negative_curvature: bool,
 }
 
 fn dot(a: &[DVec3], b: &[DVec3]) -> f64 {
@@ -524,7 +527,7 @@ pub fn pcg(
     let mut r: Vec<DVec3> = b.iter().zip(a.fixed).map(|(&v, &f)| if f { DVec3::ZERO } else { v }).collect();
     let b_norm = dot(&r, &r).sqrt();
     if b_norm == 0.0 {
-        return CgReport { iterations: 0, relative_residual: 0.0 };
+        return CgReport { iterations: 0, relative_residual: 0.0, negative_curvature: false };
     }
     let mut z = vec![DVec3::ZERO; n];
     preconditioner.apply(&r, &mut z);
@@ -533,10 +536,12 @@ pub fn pcg(
     let mut rz = dot(&r, &z);
     let mut iterations = 0;
     let mut residual = 1.0;
+    let mut negative_curvature = false;
     while iterations < max_iterations {
         a.apply(&p, &mut ap);
         let pap = dot(&p, &ap);
         if pap <= 0.0 || !pap.is_finite() {
+            negative_curvature = true;
             break;
         }
         let alpha = rz / pap;
@@ -557,7 +562,7 @@ pub fn pcg(
             p[i] = z[i] + beta * p[i];
         }
     }
-    CgReport { iterations, relative_residual: residual }
+    CgReport { iterations, relative_residual: residual, negative_curvature }
 }
 
 #[cfg(test)]

@@ -22,12 +22,18 @@
 //!   reduced by a Coulomb impulse (stopped if μ_s·|Δv_n| suffices). This adds no stiffness,
 //!   so the explicit stability limit is the cloth's own.
 //! - Cloth–cloth: vertex–triangle pairs closer than the layer thickness δ at the start of
-//!   a step (found with a spatial hash) get the repulsion ½k·max(0, δ − d)², d the
+//!   a step (found in a list of near pairs, below) get the repulsion ½k·max(0, δ − d)², d the
 //!   point–triangle distance, in the implicit solve. Whatever the solve did, a continuous
 //!   collision test of every vertex–triangle and edge–edge pair over the step follows; the
 //!   vertices of a pair that would cross are held at their start positions and share
 //!   their mean velocity (an inelastic impact zone), repeated until no pair crosses. The
 //!   start of the step is free of crossings, so this always ends with none.
+//! - Both cloth–cloth searches read a list of vertex–triangle and edge–edge pairs that were
+//!   near when it was built (a Verlet list, as molecular dynamics keeps for its neighbours:
+//!   found with a spatial hash, out to a reach with a skin to spare). A pair not listed was
+//!   at least the reach apart then, and no two vertices have since closed more than twice
+//!   the largest displacement, so the list serves until displacements and the step's
+//!   motion use up the skin; then it is rebuilt. On a draping cloth it lasts many steps.
 
 pub mod geometry;
 pub mod props;
@@ -38,6 +44,7 @@ use crate::sim::model::Model;
 use crate::sim::sparse::{BlockCsr, Coupling};
 use geometry::{SpatialHash, closest_point_triangle, closest_points_segments, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
 use glam::{DMat3, DVec3};
+use std::sync::Mutex;
 
 /// Contact parameters, SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,6 +106,81 @@ pub struct ContactModel {
     pub settings: ContactSettings,
     /// World bounding box of each prop (None: unbounded, the ground).
     bounds: Vec<Option<(DVec3, DVec3)>>,
+    /// Cloth–cloth pairs near enough to meet soon, kept from step to step.
+    near: NearPairCache,
+}
+
+/// Cloth–cloth pairs closer than `reach` at positions `origin` (by their bounding boxes).
+#[derive(Debug, Default)]
+struct NearPairs {
+    origin: Vec<DVec3>,
+    reach: f64,
+    /// (vertex, triangle index).
+    vertex_triangle: Vec<(u32, u32)>,
+    /// (edge, edge) indices, first < second, sharing no vertex.
+    edge_edge: Vec<(u32, u32)>,
+}
+
+impl NearPairs {
+    /// Whether every pair that comes within `margin` while its vertices move at most
+    /// `motion` from `start` is listed: in the worst case two vertices have closed by
+    /// twice the largest displacement since the list was built and by twice `motion`.
+    fn covers(&self, start: &[DVec3], motion: f64, margin: f64) -> bool {
+        if self.origin.len() != start.len() {
+            return false;
+        }
+        let moved = start.iter().zip(&self.origin).map(|(a, b)| a.distance_squared(*b)).fold(0.0, f64::max).sqrt();
+        2.0 * moved + 2.0 * motion + margin <= self.reach
+    }
+
+    fn build(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], reach: f64) -> Self {
+        let cell = mean_edge(x, triangles).max(reach).max(1e-6);
+        let points: Vec<_> = x.iter().map(|&p| (p, p)).collect();
+        let hash = SpatialHash::new(cell, &points);
+        let pad = DVec3::splat(reach);
+        let mut vertex_triangle = Vec::new();
+        let mut seen = Vec::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            let c = tri.map(|i| x[i as usize]);
+            let (lo, hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+            seen.clear();
+            hash.query_box(lo - pad, hi + pad, |v| {
+                if !tri.contains(&v) && !seen.contains(&v) && boxes_overlap((x[v as usize], x[v as usize]), (lo, hi), reach) {
+                    seen.push(v);
+                }
+            });
+            vertex_triangle.extend(seen.iter().map(|&v| (v, t as u32)));
+        }
+        let segment = |e: usize| {
+            let [a, b] = edges[e].map(|i| x[i as usize]);
+            (a.min(b), a.max(b))
+        };
+        let boxes: Vec<_> = (0..edges.len()).map(segment).collect();
+        let hash = SpatialHash::new(cell, &boxes);
+        let mut edge_edge = Vec::new();
+        for (e, &[a, b]) in edges.iter().enumerate() {
+            seen.clear();
+            hash.query_box(boxes[e].0 - pad, boxes[e].1 + pad, |f| {
+                let [c, d] = edges[f as usize];
+                if (f as usize) > e && c != a && c != b && d != a && d != b && !seen.contains(&f) && boxes_overlap(boxes[e], boxes[f as usize], reach) {
+                    seen.push(f);
+                }
+            });
+            edge_edge.extend(seen.iter().map(|&f| (e as u32, f)));
+        }
+        Self { origin: x.to_vec(), reach, vertex_triangle, edge_edge }
+    }
+}
+
+/// The near-pair list behind a lock, so that the contact model's searches can renew it
+/// through a shared reference; a clone starts without one.
+#[derive(Debug, Default)]
+struct NearPairCache(Mutex<NearPairs>);
+
+impl Clone for NearPairCache {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 /// A vertex held outside a prop by a plane over one step.
@@ -161,7 +243,20 @@ impl ContactModel {
                 Some((lo, hi))
             })
             .collect();
-        Ok(Self { props, settings, bounds })
+        Ok(Self { props, settings, bounds, near: NearPairCache::default() })
+    }
+
+    /// The near-pair list for a search from `start` over paths of at most `motion` for
+    /// pairs that come within `margin`, renewed if it does not cover them.
+    fn near_pairs(&self, model: &Model, start: &[DVec3], motion: f64, margin: f64) -> std::sync::MutexGuard<'_, NearPairs> {
+        // The skin: half an edge lets a draping cloth keep its list for many steps while
+        // adding few pairs beyond those in reach.
+        let skin = 0.5 * model.mean_edge_length;
+        let mut near = self.near.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if !near.covers(start, motion, margin) {
+            *near = NearPairs::build(start, &model.triangles, &model.edges, margin + 2.0 * motion + skin);
+        }
+        near
     }
 
     fn near_bounds(&self, prop: usize, a: DVec3, b: DVec3, margin: f64) -> bool {
@@ -312,87 +407,50 @@ impl ContactModel {
         }
     }
 
-    /// Vertex–triangle pairs within reach over the step.
+    /// Vertex–triangle and edge–edge pairs within reach over the step.
     fn self_pairs(&self, model: &Model, start: &[DVec3], predicted: &[DVec3], h: f64) -> Vec<SelfPair> {
         let (fixed, mass, triangles, edges) = (&model.fixed, &model.mass, &model.triangles, &model.edges);
         let delta = self.settings.self_thickness;
-        let motion = |v: usize| (predicted[v] - start[v]).length();
-        let cell = mean_edge(start, triangles).max(2.0 * delta);
-        let mut hash = SpatialHash::new(cell);
-        for v in 0..start.len() {
-            let (lo, hi) = (start[v].min(predicted[v]), start[v].max(predicted[v]));
-            hash.insert_box(v as u32, lo, hi);
-        }
+        let motion: Vec<f64> = start.iter().zip(predicted).map(|(a, b)| a.distance(*b)).collect();
+        let near = self.near_pairs(model, start, motion.iter().copied().fold(0.0, f64::max), delta);
+        let stiffness = |m: f64| self.settings.stiffness * m / (h * h);
         let mut pairs = Vec::new();
-        let mut seen = Vec::new();
-        for t in triangles {
-            let corners = t.map(|i| i as usize);
-            let lo = corners.iter().fold(DVec3::INFINITY, |a, &i| a.min(start[i]).min(predicted[i])) - DVec3::splat(delta);
-            let hi = corners.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(start[i]).max(predicted[i])) + DVec3::splat(delta);
-            let tri_motion = corners.iter().map(|&i| motion(i)).fold(0.0, f64::max);
-            // The triangle's box at the start: a vertex farther from it than the reach
-            // below is farther from the triangle too.
-            let start_lo = corners.iter().fold(DVec3::INFINITY, |a, &i| a.min(start[i]));
-            let start_hi = corners.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(start[i]));
-            seen.clear();
-            hash.query_box(lo, hi, |v| {
-                if !t.contains(&v) && !seen.contains(&v) {
-                    seen.push(v);
-                }
-            });
-            for &v in &seen {
-                let vi = v as usize;
-                if fixed[vi] && corners.iter().all(|&i| fixed[i]) {
-                    continue;
-                }
-                let reach = delta + motion(vi) + tri_motion;
-                if !boxes_overlap((start[vi], start[vi]), (start_lo, start_hi), reach) {
-                    continue;
-                }
-                let (q, _) = closest_point_triangle(start[vi], start[corners[0]], start[corners[1]], start[corners[2]]);
-                if (q - start[vi]).length() < reach {
-                    let m = 0.25 * (mass[vi] + corners.iter().map(|&i| mass[i]).sum::<f64>());
-                    pairs.push(SelfPair { vertices: [v, t[0], t[1], t[2]], edge_edge: false, stiffness: self.settings.stiffness * m / (h * h) });
-                }
+        for &(v, t) in &near.vertex_triangle {
+            let (vi, tri) = (v as usize, triangles[t as usize]);
+            let corners = tri.map(|i| i as usize);
+            if fixed[vi] && corners.iter().all(|&i| fixed[i]) {
+                continue;
+            }
+            let reach = delta + motion[vi] + corners.iter().map(|&i| motion[i]).fold(0.0, f64::max);
+            // The triangle's box at the start: a vertex farther from it than the reach is
+            // farther from the triangle too.
+            let c = corners.map(|i| start[i]);
+            if !boxes_overlap((start[vi], start[vi]), (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2])), reach) {
+                continue;
+            }
+            let (q, _) = closest_point_triangle(start[vi], c[0], c[1], c[2]);
+            if (q - start[vi]).length() < reach {
+                let m = 0.25 * (mass[vi] + corners.iter().map(|&i| mass[i]).sum::<f64>());
+                pairs.push(SelfPair { vertices: [v, tri[0], tri[1], tri[2]], edge_edge: false, stiffness: stiffness(m) });
             }
         }
         // Edges can pass through each other with every vertex far from every triangle.
-        let mut edge_hash = SpatialHash::new(cell);
-        let swept = |i: usize| (start[i].min(predicted[i]), start[i].max(predicted[i]));
-        for (e, [a, b]) in edges.iter().enumerate() {
-            let (a, b) = (*a as usize, *b as usize);
-            edge_hash.insert_box(e as u32, swept(a).0.min(swept(b).0), swept(a).1.max(swept(b).1));
-        }
-        for (e, [a, b]) in edges.iter().enumerate() {
-            let (a, b) = (*a as usize, *b as usize);
-            let lo = swept(a).0.min(swept(b).0) - DVec3::splat(delta);
-            let hi = swept(a).1.max(swept(b).1) + DVec3::splat(delta);
-            seen.clear();
-            edge_hash.query_box(lo, hi, |f| {
-                if (f as usize) > e && !seen.contains(&f) {
-                    seen.push(f);
-                }
-            });
-            for &f in &seen {
-                let [c, d] = edges[f as usize].map(|i| i as usize);
-                if c == a || c == b || d == a || d == b || (fixed[a] && fixed[b] && fixed[c] && fixed[d]) {
-                    continue;
-                }
-                let reach = delta + motion(a).max(motion(b)) + motion(c).max(motion(d));
-                let segment_box = |p: usize, q: usize| (start[p].min(start[q]), start[p].max(start[q]));
-                if !boxes_overlap(segment_box(a, b), segment_box(c, d), reach) {
-                    continue;
-                }
-                let (sa, tb) = closest_points_segments(start[a], start[b], start[c], start[d]);
-                let gap = (start[a].lerp(start[b], sa) - start[c].lerp(start[d], tb)).length();
-                if gap < reach {
-                    let m = 0.25 * (mass[a] + mass[b] + mass[c] + mass[d]);
-                    pairs.push(SelfPair {
-                        vertices: [a as u32, b as u32, c as u32, d as u32],
-                        edge_edge: true,
-                        stiffness: self.settings.stiffness * m / (h * h),
-                    });
-                }
+        for &(e, f) in &near.edge_edge {
+            let [a, b] = edges[e as usize].map(|i| i as usize);
+            let [c, d] = edges[f as usize].map(|i| i as usize);
+            if fixed[a] && fixed[b] && fixed[c] && fixed[d] {
+                continue;
+            }
+            let reach = delta + motion[a].max(motion[b]) + motion[c].max(motion[d]);
+            let segment_box = |p: usize, q: usize| (start[p].min(start[q]), start[p].max(start[q]));
+            if !boxes_overlap(segment_box(a, b), segment_box(c, d), reach) {
+                continue;
+            }
+            let (sa, tb) = closest_points_segments(start[a], start[b], start[c], start[d]);
+            let gap = (start[a].lerp(start[b], sa) - start[c].lerp(start[d], tb)).length();
+            if gap < reach {
+                let m = 0.25 * (mass[a] + mass[b] + mass[c] + mass[d]);
+                pairs.push(SelfPair { vertices: [a as u32, b as u32, c as u32, d as u32], edge_edge: true, stiffness: stiffness(m) });
             }
         }
         pairs
@@ -416,7 +474,8 @@ impl ContactModel {
         let mut stopped = 0u64;
         let mut frozen = vec![false; n];
         for _round in 0..50 {
-            let crossings = find_crossings(start, end, triangles, edges, eps);
+            let motion = start.iter().zip(end.iter()).map(|(a, b)| a.distance_squared(*b)).fold(0.0, f64::max).sqrt();
+            let crossings = find_crossings(start, end, triangles, edges, &self.near_pairs(model, start, motion, eps), eps);
             if crossings.is_empty() {
                 break;
             }
@@ -466,76 +525,41 @@ fn mean_edge(x: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
     sum / triangles.len().clamp(1, 64) as f64
 }
 
-/// Groups of vertices of pairs that cross over the step.
-fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], eps: f64) -> Vec<Vec<u32>> {
-    let cell = mean_edge(start, triangles).max(1e-6);
+/// Groups of vertices of pairs that cross over the step, among the `near` pairs (which must
+/// cover the step's paths).
+fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], near: &NearPairs, eps: f64) -> Vec<Vec<u32>> {
     let swept = |i: usize| (start[i].min(end[i]), start[i].max(end[i]));
-    let mut vertices = SpatialHash::new(cell);
-    for i in 0..start.len() {
-        let (lo, hi) = swept(i);
-        vertices.insert_box(i as u32, lo, hi);
-    }
-    let mut found = Vec::new();
-    let mut seen = Vec::new();
     let moving = |i: usize| start[i] != end[i];
-    for t in triangles {
-        let c = t.map(|i| i as usize);
-        let lo = c.iter().fold(DVec3::INFINITY, |a, &i| a.min(swept(i).0)) - DVec3::splat(eps);
-        let hi = c.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(swept(i).1)) + DVec3::splat(eps);
-        seen.clear();
-        vertices.query_box(lo, hi, |v| {
-            if !t.contains(&v) && !seen.contains(&v) {
-                seen.push(v);
-            }
-        });
-        for &v in &seen {
-            let p = v as usize;
-            if !moving(p) && c.iter().all(|&i| !moving(i)) {
-                continue;
-            }
-            // The hash's cells are an edge long; the paths of a step are far shorter.
-            if !boxes_overlap(swept(p), (lo, hi), 0.0) {
-                continue;
-            }
-            let path = |i: usize| [start[i], end[i]];
-            if vertex_triangle_ccd(path(p), path(c[0]), path(c[1]), path(c[2]), eps).is_some() {
-                found.push(vec![v, t[0], t[1], t[2]]);
-            }
+    let path = |i: usize| [start[i], end[i]];
+    let mut found = Vec::new();
+    for &(v, t) in &near.vertex_triangle {
+        let (p, tri) = (v as usize, triangles[t as usize]);
+        let c = tri.map(|i| i as usize);
+        if !moving(p) && c.iter().all(|&i| !moving(i)) {
+            continue;
+        }
+        let lo = c.iter().fold(DVec3::INFINITY, |a, &i| a.min(swept(i).0));
+        let hi = c.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(swept(i).1));
+        if !boxes_overlap(swept(p), (lo, hi), eps) {
+            continue;
+        }
+        if vertex_triangle_ccd(path(p), path(c[0]), path(c[1]), path(c[2]), eps).is_some() {
+            found.push(vec![v, tri[0], tri[1], tri[2]]);
         }
     }
-    let mut edge_hash = SpatialHash::new(cell);
-    for (e, [a, b]) in edges.iter().enumerate() {
-        let (a, b) = (*a as usize, *b as usize);
-        let lo = swept(a).0.min(swept(b).0) - DVec3::splat(eps);
-        let hi = swept(a).1.max(swept(b).1) + DVec3::splat(eps);
-        edge_hash.insert_box(e as u32, lo, hi);
-    }
-    for (e, [a, b]) in edges.iter().enumerate() {
-        let (a, b) = (*a as usize, *b as usize);
-        let lo = swept(a).0.min(swept(b).0);
-        let hi = swept(a).1.max(swept(b).1);
-        seen.clear();
-        edge_hash.query_box(lo, hi, |f| {
-            if (f as usize) > e && !seen.contains(&f) {
-                seen.push(f);
-            }
-        });
-        for &f in &seen {
-            let [c, d] = edges[f as usize].map(|i| i as usize);
-            if c == a || c == b || d == a || d == b {
-                continue;
-            }
-            if !moving(a) && !moving(b) && !moving(c) && !moving(d) {
-                continue;
-            }
-            let other = (swept(c).0.min(swept(d).0), swept(c).1.max(swept(d).1));
-            if !boxes_overlap((lo, hi), other, eps) {
-                continue;
-            }
-            let path = |i: usize| [start[i], end[i]];
-            if edge_edge_ccd(path(a), path(b), path(c), path(d), eps).is_some() {
-                found.push(vec![a as u32, b as u32, c as u32, d as u32]);
-            }
+    for &(e, f) in &near.edge_edge {
+        let [a, b] = edges[e as usize].map(|i| i as usize);
+        let [c, d] = edges[f as usize].map(|i| i as usize);
+        if !moving(a) && !moving(b) && !moving(c) && !moving(d) {
+            continue;
+        }
+        let one = (swept(a).0.min(swept(b).0), swept(a).1.max(swept(b).1));
+        let other = (swept(c).0.min(swept(d).0), swept(c).1.max(swept(d).1));
+        if !boxes_overlap(one, other, eps) {
+            continue;
+        }
+        if edge_edge_ccd(path(a), path(b), path(c), path(d), eps).is_some() {
+            found.push(vec![a as u32, b as u32, c as u32, d as u32]);
         }
     }
     found
@@ -544,11 +568,14 @@ fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges:
 /// Edge–triangle crossings in a mesh (edges that share no vertex with the triangle).
 pub fn count_self_intersections(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]]) -> usize {
     let cell = mean_edge(x, triangles).max(1e-6);
-    let mut hash = SpatialHash::new(cell);
-    for (t, tri) in triangles.iter().enumerate() {
-        let c = tri.map(|i| x[i as usize]);
-        hash.insert_box(t as u32, c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
-    }
+    let boxes: Vec<_> = triangles
+        .iter()
+        .map(|tri| {
+            let c = tri.map(|i| x[i as usize]);
+            (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
+        })
+        .collect();
+    let hash = SpatialHash::new(cell, &boxes);
     let mut count = 0;
     let mut seen = Vec::new();
     for [a, b] in edges {
@@ -679,11 +706,22 @@ impl StepContacts {
                 block += c.stiffness * outer(c.normal, c.normal);
             }
             if c.normal_force > 0.0 {
+                // λF(s) of the slip s = |u_T|: curvature λF'(s)/s across the slip and λF''(s)
+                // along it. Sticking (s ≤ ε), F is quadratic and both are μ_s/ε. Sliding,
+                // F'' < 0 as μ decays to μ_k; 0 is used there. λF'(s)/s along the slip, as
+                // before, was up to μ_s/ε·λ: twenty times a resting vertex's inertia at the
+                // drape's slip threshold, so Newton crept along a sliding vertex's path at
+                // 0.3 µm an iteration.
                 let u = y[i] - anchor[i];
-                let slip = (u - u.dot(c.normal) * c.normal).length();
+                let t = u - u.dot(c.normal) * c.normal;
+                let slip = t.length();
                 let tangent = DMat3::IDENTITY - outer(c.normal, c.normal);
                 let (_, dfriction) = self.friction(slip.max(self.slip));
                 block += tangent * (c.normal_force * dfriction / slip.max(self.slip));
+                if slip > self.slip {
+                    let along = t / slip;
+                    block -= outer(along, along) * (c.normal_force * dfriction / slip);
+                }
             }
             let slot = k.diagonal_slot(i as u32);
             k.values[slot] += block;
@@ -756,4 +794,73 @@ impl StepContacts {
 
 fn outer(a: DVec3, b: DVec3) -> DMat3 {
     DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::mesh::{Mesh, Pattern};
+    use crate::sim::model::{PhysicsOptions, tests::test_fabric};
+    use glam::DVec2;
+    use std::collections::BTreeSet;
+
+    /// Every pair the step's search must find, by testing all of them.
+    fn all_pairs(model: &Model, start: &[DVec3], predicted: &[DVec3], delta: f64) -> BTreeSet<([u32; 4], bool)> {
+        let motion = |i: usize| start[i].distance(predicted[i]);
+        let mut found = BTreeSet::new();
+        for (v, &p) in start.iter().enumerate() {
+            for tri in &model.triangles {
+                if tri.contains(&(v as u32)) {
+                    continue;
+                }
+                let c = tri.map(|i| i as usize);
+                let reach = delta + motion(v) + c.iter().map(|&i| motion(i)).fold(0.0, f64::max);
+                let (q, _) = closest_point_triangle(p, start[c[0]], start[c[1]], start[c[2]]);
+                if (q - p).length() < reach {
+                    found.insert(([v as u32, tri[0], tri[1], tri[2]], false));
+                }
+            }
+        }
+        for (e, &[a, b]) in model.edges.iter().enumerate() {
+            for &[c, d] in &model.edges[e + 1..] {
+                if c == a || c == b || d == a || d == b {
+                    continue;
+                }
+                let [a, b, c, d] = [a, b, c, d].map(|i| i as usize);
+                let reach = delta + motion(a).max(motion(b)) + motion(c).max(motion(d));
+                let (s, t) = closest_points_segments(start[a], start[b], start[c], start[d]);
+                if (start[a].lerp(start[b], s) - start[c].lerp(start[d], t)).length() < reach {
+                    found.insert(([a, b, c, d].map(|i| i as u32), true));
+                }
+            }
+        }
+        found
+    }
+
+    /// A strip folded over itself, its layers sliding past each other: the near-pair
+    /// list, kept or renewed, must give exactly the pairs an exhaustive search gives.
+    #[test]
+    fn near_pair_list_finds_every_pair_an_exhaustive_search_finds() {
+        let mesh = Mesh::rectangle(0.04, 0.02, 0.004, Pattern::Regular, 0).unwrap();
+        let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
+        let settings = ContactSettings { self_collision: true, self_thickness: 0.002, ..Default::default() };
+        let contact = ContactModel::new(Vec::new(), settings).unwrap();
+        let folded = |p: DVec2, drift: DVec3| {
+            // The layers drift apart in opposite directions, as closing pairs would.
+            if p.x <= 0.02 { DVec3::new(p.x, p.y, 0.0) - drift * (0.02 - p.x) / 0.02 } else { DVec3::new(0.04 - p.x, p.y, 0.0015) + drift * (p.x - 0.02) / 0.02 }
+        };
+        let mut total = 0;
+        for step in 0..12 {
+            let t = step as f64;
+            let drift = |t: f64| DVec3::new(0.0015 * t, 0.001 * (0.7 * t).sin(), -0.0001 * t);
+            let start: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, drift(t))).collect();
+            let predicted: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, drift(t + 1.0))).collect();
+            let contacts = contact.begin_step(&model, &start, &predicted, 0.004);
+            let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
+            assert_eq!(listed.len(), contacts.pairs.len(), "step {step}: a pair listed twice");
+            assert_eq!(listed, all_pairs(&model, &start, &predicted, settings.self_thickness), "step {step}");
+            total += listed.len();
+        }
+        assert!(total > 100, "the fold should bring many pairs within reach: {total}");
+    }
 }
