@@ -100,6 +100,13 @@ impl PiecewiseLinear {
     }
 
     /// The tangent slope `dy/dx` at `x` (the right-hand slope at a knot).
+    /// `(value(x), slope(x))` with one search for the segment.
+    pub fn value_and_slope(&self, x: f64) -> (f64, f64) {
+        let i = self.segment(x);
+        let slope = self.slope_of_segment(i);
+        (self.ys[i] + slope * (x - self.xs[i]), slope)
+    }
+
     pub fn slope(&self, x: f64) -> f64 {
         self.slope_of_segment(self.segment(x))
     }

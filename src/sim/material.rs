@@ -188,6 +188,14 @@ impl MembraneLaw {
         ]
     }
 
+    /// `(stress(e), tangent(e))`, each curve searched once.
+    pub fn stress_and_tangent(&self, e: [f64; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
+        let ((fx, sx), (fy, sy)) = (self.warp.value_and_slope(e[0]), self.weft.value_and_slope(e[1]));
+        let stress = [fx + self.correction_x * e[0] + self.coupling * e[1], fy + self.correction_y * e[1] + self.coupling * e[0], self.shear * e[2]];
+        let tangent = [[sx + self.correction_x, self.coupling, 0.0], [self.coupling, sy + self.correction_y, 0.0], [0.0, 0.0, self.shear]];
+        (stress, tangent)
+    }
+
     /// Largest tangent stiffness the law can reach, N/m (bounds explicit time steps).
     pub fn max_stiffness(&self) -> f64 {
         (self.warp.max_slope() + self.correction_x).max(self.weft.max_slope() + self.correction_y) + self.coupling
@@ -320,6 +328,10 @@ mod tests {
             em[k] -= 1e-7;
             let numeric = (law.energy(ep) - law.energy(em)) / 2e-7;
             assert!((numeric - s[k]).abs() < 1e-5 * (1.0 + s[k].abs()), "component {k}");
+        }
+        // The combined evaluation is the same law.
+        for e in [e, [-0.004, 0.031, -0.02], [0.0, 0.0, 0.0], [0.09, -0.05, 0.2]] {
+            assert_eq!(law.stress_and_tangent(e), (law.stress(e), law.tangent(e)));
         }
     }
 

@@ -632,7 +632,7 @@ const UPPER_BLOCKS: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2
 /// vertices.
 fn triangle_stiffness(tri: &RosetteTriangle, law: &MembraneLaw, x: &[DVec3], ratio: &[f64]) -> [DMat3; 6] {
     let (strain, dirs, lengths) = rosette_strain(tri, x);
-    let c = law.tangent(strain);
+    let (stress, c) = law.stress_and_tangent(strain);
     let g = &tri.strain_from_edges;
     let mut ke = [[0.0; 3]; 3];
     for p in 0..3 {
@@ -647,7 +647,7 @@ fn triangle_stiffness(tri: &RosetteTriangle, law: &MembraneLaw, x: &[DVec3], rat
             ke[q][p] = ke[p][q];
         }
     }
-    let tension = edge_tensions(tri, law.stress(strain));
+    let tension = edge_tensions(tri, stress);
     let geometric: [DMat3; 3] = [0, 1, 2].map(|p| {
         let scale = if tension[p] > 0.0 {
             1.0
@@ -657,22 +657,16 @@ fn triangle_stiffness(tri: &RosetteTriangle, law: &MembraneLaw, x: &[DVec3], rat
         };
         if scale > 0.0 && lengths[p] > 0.0 { (DMat3::IDENTITY - outer(dirs[p], dirs[p])) * (scale * tension[p] / lengths[p]) } else { DMat3::ZERO }
     });
-    // M_pq = K_pq u_p u_qᵀ; M_qp = M_pqᵀ.
-    let mut m = [[DMat3::ZERO; 3]; 3];
-    for p in 0..3 {
-        for q in p..3 {
-            m[p][q] = outer(dirs[p], dirs[q]) * ke[p][q];
-            m[q][p] = m[p][q].transpose();
-        }
-    }
+    // Block (a, b) = Σ_p s_pa u_p w_bpᵀ with w_bp = Σ_q s_qb K_pq u_q: two outer products a
+    // block instead of four.
     let edges_of = |a: usize| [((a + 1) % 3, 1.0), ((a + 2) % 3, -1.0)];
+    let w: [[DVec3; 3]; 3] = [0, 1, 2].map(|b| {
+        let [(q0, s0), (q1, s1)] = edges_of(b);
+        [0, 1, 2].map(|p| dirs[q0] * (s0 * ke[p][q0]) + dirs[q1] * (s1 * ke[p][q1]))
+    });
     UPPER_BLOCKS.map(|(a, b)| {
-        let mut block = DMat3::ZERO;
-        for (p, sp) in edges_of(a) {
-            for (q, sq) in edges_of(b) {
-                block += m[p][q] * (sp * sq);
-            }
-        }
+        let [(p0, s0), (p1, s1)] = edges_of(a);
+        let mut block = outer(dirs[p0] * s0, w[b][p0]) + outer(dirs[p1] * s1, w[b][p1]);
         if a == b {
             block += geometric[(a + 1) % 3] + geometric[(a + 2) % 3];
         } else {
