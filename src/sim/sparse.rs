@@ -432,14 +432,14 @@ impl FactorPart {
         let mut scaled: Vec<DMat3> = Vec::new();
         let mut block_products = 0;
         row_start.push(0);
-        for row in lo..hi {
+        for (row, coupled_row) in (lo..hi).zip(&coupled[lo..hi]) {
             let start = cols.len();
             if !a.fixed[row] {
                 let q_row = a.bending.map_or((&[][..], 0), |q| q.row_pattern(row));
                 // The strictly lower part within this factor's rows, fixed vertices left out.
                 let keep = |col: u32| (lo..row).contains(&(col as usize)) && !a.fixed[col as usize];
                 merge_rows(k.row_pattern(row), q_row, keep, &mut merged);
-                let mut extra = coupled[row].iter().filter(|e| keep(e.0)).peekable();
+                let mut extra = coupled_row.iter().filter(|e| keep(e.0)).peekable();
                 for &(col, k_slot, q_slot) in &merged {
                     while let Some(&(c, block)) = extra.next_if(|e| e.0 < col) {
                         position[c as usize - lo] = cols.len();
