@@ -15,7 +15,7 @@
 use crate::sim::contact::{ContactModel, ContactStats, StepContacts};
 use crate::sim::model::{CompressedEdges, Model};
 use crate::sim::direct::DirectPattern;
-use crate::sim::sparse::{Preconditioner, SystemMatrix, pcg};
+use crate::sim::sparse::{BlockCsr, Preconditioner, SystemMatrix, pcg};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -609,12 +609,14 @@ impl Integrator {
                 c.couplings(y, &mut couplings);
                 timings.contact += lap(&mut clock);
             }
+            let assemble = |k: &mut BlockCsr, compressed: CompressedEdges| {
+                model.assemble_membrane_stiffness_within(y, k, compressed);
+                if let Some(c) = contacts {
+                    c.add_hessian(y, anchor, k);
+                }
+            };
             let complete = self.newton.preconditioner.complete_factor(n);
-            let compressed = if complete { CompressedEdges::Within(&softening) } else { CompressedEdges::Exact };
-            model.assemble_membrane_stiffness_within(y, &mut stiffness, compressed);
-            if let Some(c) = contacts {
-                c.add_hessian(y, anchor, &mut stiffness);
-            }
+            assemble(&mut stiffness, if complete { CompressedEdges::Within(&softening) } else { CompressedEdges::Exact });
             timings.forces += lap(&mut clock);
             let system = SystemMatrix { mass_diagonal: &mass_diagonal, stiffness: &stiffness, bending: bending.as_deref(), fixed: &model.fixed, couplings: &couplings };
             let mut bounded_ready = false;
@@ -640,10 +642,7 @@ impl Integrator {
                         None => system.preconditioner(),
                     }
                 } else {
-                    model.assemble_membrane_stiffness_within(y, &mut bounded, CompressedEdges::Within(&softening));
-                    if let Some(c) = contacts {
-                        c.add_hessian(y, anchor, &mut bounded);
-                    }
+                    assemble(&mut bounded, CompressedEdges::Within(&softening));
                     bounded_ready = true;
                     timings.forces += lap(&mut clock);
                     SystemMatrix { stiffness: &bounded, ..system }.preconditioner()
@@ -660,10 +659,7 @@ impl Integrator {
             // search and its steepest-descent fallback.)
             if !complete && (cg.negative_curvature || !descent) {
                 if !bounded_ready {
-                    model.assemble_membrane_stiffness_within(y, &mut bounded, CompressedEdges::Within(&softening));
-                    if let Some(c) = contacts {
-                        c.add_hessian(y, anchor, &mut bounded);
-                    }
+                    assemble(&mut bounded, CompressedEdges::Within(&softening));
                     timings.forces += lap(&mut clock);
                 }
                 let system = SystemMatrix { mass_diagonal: &mass_diagonal, stiffness: &bounded, bending: bending.as_deref(), fixed: &model.fixed, couplings: &couplings };
