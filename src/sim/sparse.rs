@@ -221,12 +221,10 @@ impl SystemMatrix<'_> {
     /// The complete Cholesky factor on `pattern` (made for this matrix's pattern), or the
     /// incomplete one if it is not positive definite.
     pub fn cholesky(&self, pattern: &Arc<DirectPattern>) -> Preconditioner {
-        self.complete_factor(pattern).unwrap_or_else(|| self.preconditioner())
-    }
-
-    /// The complete Cholesky factor on `pattern`; None if the matrix is not positive definite.
-    pub fn complete_factor(&self, pattern: &Arc<DirectPattern>) -> Option<Preconditioner> {
-        DirectFactor::new(pattern.clone(), self).map(Preconditioner::Cholesky)
+        match DirectFactor::new(pattern.clone(), self) {
+            Some(factor) => Preconditioner::Cholesky(factor),
+            None => self.preconditioner(),
+        }
     }
 
     /// Inverse 3×3 diagonal blocks: the block-Jacobi preconditioner.
@@ -439,12 +437,16 @@ impl FactorPart {
                 // The strictly lower part within this factor's rows, fixed vertices left out.
                 let keep = |col: u32| (lo..row).contains(&(col as usize)) && !a.fixed[col as usize];
                 merge_rows(k.row_pattern(row), q_row, keep, &mut merged);
+                let mut push = |col: u32, block: DMat3| {
+                    position[col as usize - lo] = cols.len();
+                    cols.push(col);
+                    lower.push(block);
+                };
+                // The two sorted lists merged: coupling blocks in and beside the pattern.
                 let mut extra = coupled_row.iter().filter(|e| keep(e.0)).peekable();
                 for &(col, k_slot, q_slot) in &merged {
                     while let Some(&(c, block)) = extra.next_if(|e| e.0 < col) {
-                        position[c as usize - lo] = cols.len();
-                        cols.push(c);
-                        lower.push(block);
+                        push(c, block);
                     }
                     let mut block = if k_slot == usize::MAX { DMat3::ZERO } else { k.values[k_slot] };
                     if q_slot != usize::MAX {
@@ -453,14 +455,10 @@ impl FactorPart {
                     if let Some(&(_, coupling)) = extra.next_if(|e| e.0 == col) {
                         block += coupling;
                     }
-                    position[col as usize - lo] = cols.len();
-                    cols.push(col);
-                    lower.push(block);
+                    push(col, block);
                 }
                 for &(c, block) in extra {
-                    position[c as usize - lo] = cols.len();
-                    cols.push(c);
-                    lower.push(block);
+                    push(c, block);
                 }
             }
             let end = cols.len();
