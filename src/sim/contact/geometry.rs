@@ -203,9 +203,9 @@ pub fn edge_edge_ccd(p1: [DVec3; 2], q1: [DVec3; 2], p2: [DVec3; 2], q2: [DVec3;
 /// Written by hand as a counting-sorted hash table (Teschner et al., "Optimized Spatial
 /// Hashing for Collision Detection of Deformable Objects", 2003): cells hash into a table
 /// about twice the items' count, and each bucket's items lie contiguously. Building it
-/// allocates two arrays; the map of cells to vectors it replaces allocated a vector per
-/// cell and took 2.5 times as long on the Cusick drape. Cells that share a bucket return
-/// each other's items, and an item may repeat: callers test boxes anyway.
+/// allocates two arrays, where the map of cells to vectors it replaces allocated a vector
+/// per cell. Cells that share a bucket return each other's items, and an item may repeat:
+/// callers test boxes anyway.
 pub struct SpatialHash {
     cell: f64,
     mask: u32,
