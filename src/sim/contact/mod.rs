@@ -764,7 +764,13 @@ impl StepContacts {
     /// Capping each line search there keeps every Newton iterate free of crossings, so the
     /// solve cannot carry a vertex around a triangle's edge to the far side.
     pub fn max_step(&self, y: &[DVec3], d: &[DVec3]) -> f64 {
-        let mut alpha = 1.0f64;
+        self.step_limit(y, d).min(1.0)
+    }
+
+    /// The multiple of `d` (any size) from `y` up to which no cloth–cloth pair can meet; see
+    /// [`Self::max_step`].
+    pub fn step_limit(&self, y: &[DVec3], d: &[DVec3]) -> f64 {
+        let mut alpha = f64::INFINITY;
         for p in &self.pairs {
             let v = p.vertices.map(|i| d[i as usize].length());
             let bound = if p.edge_edge { v[0].max(v[1]) + v[2].max(v[3]) } else { v[0] + v[1].max(v[2]).max(v[3]) };
