@@ -107,7 +107,10 @@ impl DirectPattern {
 /// The Cholesky factor of one Newton matrix.
 pub struct DirectFactor {
     pattern: Arc<DirectPattern>,
-    values: Vec<f64>,
+    /// L's entries in single precision: the triangular solves are bound by reading them and
+    /// the factorisation by the arithmetic on them, and a preconditioner needs no more
+    /// digits (as for the incomplete factor's blocks).
+    values: Vec<f32>,
     /// Estimated cost of the factorisation in solves with it: a column of c entries costs
     /// about c² multiply-adds to factor and 4c to solve with.
     pub cost_in_iterations: f64,
@@ -118,13 +121,14 @@ impl DirectFactor {
     /// positive definite.
     pub fn new(pattern: Arc<DirectPattern>, a: &SystemMatrix) -> Option<Self> {
         let k = a.stiffness;
-        let values: Vec<f64> = pattern
+        let values: Vec<f32> = pattern
             .sources
             .iter()
             .map(|s| {
                 if s.block == u32::MAX && s.bending == u32::MAX && s.mass == u32::MAX {
                     return if s.a == s.b { 1.0 } else { 0.0 };
                 }
+                // Summed in double precision, stored in single.
                 let mut value = 0.0;
                 if s.block != u32::MAX {
                     value += k.values[s.block as usize].col(s.b as usize)[s.a as usize];
@@ -135,7 +139,7 @@ impl DirectFactor {
                 if s.mass != u32::MAX {
                     value += a.mass_diagonal[s.mass as usize];
                 }
-                value
+                value as f32
             })
             .collect();
         let size = 3 * a.fixed.len();
@@ -144,11 +148,11 @@ impl DirectFactor {
             SymbolicSparseColMatRef::new_checked(size, size, &pattern.col_ptr, None, &pattern.row_idx),
             &values,
         );
-        let mut factor = vec![0.0; symbolic.len_val()];
+        let mut factor = vec![0.0f32; symbolic.len_val()];
         let par = parallelism(size);
-        let mut buffer = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
+        let mut buffer = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f32>(par, Default::default()));
         symbolic
-            .factorize_numeric_llt::<f64>(
+            .factorize_numeric_llt::<f32>(
                 &mut factor,
                 matrix,
                 Side::Lower,
@@ -166,18 +170,18 @@ impl DirectFactor {
     /// z = (LLᵀ)⁻¹ r.
     pub fn solve(&self, r: &[DVec3], z: &mut [DVec3]) {
         let symbolic = &self.pattern.symbolic;
-        let mut flat: Vec<f64> = r.iter().flat_map(|v| v.to_array()).collect();
+        let mut flat: Vec<f32> = r.iter().flat_map(|v| v.to_array().map(|c| c as f32)).collect();
         let size = flat.len();
         let par = parallelism(size);
-        let mut buffer = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
-        LltRef::<'_, u32, f64>::new(symbolic, &self.values).solve_in_place_with_conj(
+        let mut buffer = MemBuffer::new(symbolic.solve_in_place_scratch::<f32>(1, par));
+        LltRef::<'_, u32, f32>::new(symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(&mut flat, size, 1),
             par,
             MemStack::new(&mut buffer),
         );
         for (i, zi) in z.iter_mut().enumerate() {
-            *zi = DVec3::new(flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]);
+            *zi = DVec3::new(flat[3 * i] as f64, flat[3 * i + 1] as f64, flat[3 * i + 2] as f64);
         }
     }
 }
