@@ -723,24 +723,21 @@ impl Integrator {
             }
             let length = direction.iter().map(|d| d.length()).fold(0.0, f64::max);
             if accepted && alpha == 1.0 && length > 10.0 * tolerance {
-                // Where Φ is nearly flat along d (a soft mode whose softening the bounded
-                // matrix leaves out), a full step is accepted yet falls far short of the
-                // minimum along d, and Newton creeps: at 20 463 triangles it took steps of
-                // ~5 µm with no decrease in the gradient until the iteration limit. The
-                // parabola through Φ(0), Φ'(0) and Φ(1) places the minimum along d; a step
-                // towards it (at most EXTRAPOLATION times the full step, short of any
-                // cloth–cloth pair and of a tenth of an edge per vertex) is kept if Φ is lower
-                // there. On a quadratic Φ with Newton's direction the parabola's minimum is
-                // at 1 and nothing is tried.
+                // Where Φ is flatter along d than the matrix says, a full step is accepted
+                // yet falls short of the minimum along d. The parabola through Φ(0), Φ'(0)
+                // and Φ(1) places that minimum; a step towards it (at most EXTRAPOLATION
+                // times the full step, short of any cloth–cloth pair and of a tenth of an
+                // edge per vertex) is kept if Φ is lower there. On a quadratic Φ with
+                // Newton's direction the parabola's minimum is at 1 and nothing is tried.
+                // At 20 463 triangles, where Newton creeps in steps of a few µm, it fired in
+                // about 40 % of the iterations over the first 0.3 s and cut them 1229 → 1110;
+                // it never fires on the coarse scenes.
                 let curvature = 2.0 * (phi - phi0 - slope);
                 let best = if curvature > 0.0 { -slope / curvature } else { f64::INFINITY };
                 let reach = 0.1 * model.mean_edge_length / length;
                 let target = best.min(EXTRAPOLATION).min(0.9 * limit).min(reach);
                 if target > 1.5 {
-                    let mut further = trial.clone();
-                    for i in 0..n {
-                        further[i] = y[i] + target * direction[i];
-                    }
+                    let further: Vec<DVec3> = (0..n).map(|i| y[i] + target * direction[i]).collect();
                     let phi_further = objective(&further);
                     if phi_further < phi {
                         alpha = target;
