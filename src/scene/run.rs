@@ -45,6 +45,8 @@ pub struct Metrics {
     pub contact_events: Option<serde_json::Value>,
     pub newton_iterations: u64,
     pub cg_iterations: u64,
+    /// Preconditioners built for the linear solves (factorisations).
+    pub factorizations: u64,
     /// Peak resident memory of the process, bytes (Linux; absent elsewhere).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_memory_bytes: Option<u64>,
@@ -72,7 +74,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let wall = Instant::now();
     let cpu = cpu_time::ProcessTime::now();
     let start_time = scene.state.time;
-    let (mut newton, mut cg) = (0u64, 0u64);
+    let (mut newton, mut cg, mut factorizations) = (0u64, 0u64, 0u64);
     let mut step_time = StepTimings::default();
     let mut rejected = 0u64;
     let mut error = None;
@@ -90,6 +92,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             Ok(report) => {
                 newton += report.newton_iterations as u64;
                 cg += report.cg_iterations as u64;
+                factorizations += report.factorizations as u64;
                 step_time += report.timings;
                 rejected += report.rejected as u64;
             }
@@ -147,6 +150,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         }),
         newton_iterations: newton,
         cg_iterations: cg,
+        factorizations,
         rejected_steps: rejected,
         peak_memory_bytes: peak_memory_bytes(),
         step_time,

@@ -14,8 +14,8 @@
 
 use crate::sim::contact::{ContactModel, ContactStats, StepContacts};
 use crate::sim::model::{CompressedEdges, Model};
-use crate::sim::direct::DirectPattern;
-use crate::sim::sparse::{BlockCsr, Preconditioner, SystemMatrix, pcg};
+use crate::sim::direct::{DirectFactor, DirectPattern};
+use crate::sim::sparse::{BlockCsr, CgReport, Preconditioner, SystemMatrix, pcg};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -212,6 +212,8 @@ pub enum StepError {
 pub struct StepReport {
     pub newton_iterations: usize,
     pub cg_iterations: usize,
+    /// Preconditioners built (factorisations, complete or incomplete; failed ones included).
+    pub factorizations: usize,
     /// True when Newton stopped at its iteration limit before reaching its tolerance.
     pub newton_unconverged: bool,
     /// Where the step's time went.
@@ -220,6 +222,9 @@ pub struct StepReport {
     pub dt: f64,
     /// Attempts thrown away by the adaptive step control before this one stood.
     pub rejected: usize,
+    /// The largest shift Newton's matrix took to stay positive definite, as a share of the
+    /// inertia (meshes with a complete factor; `Integrator::solve_shifted`).
+    pub shift: f64,
 }
 
 impl StepReport {
@@ -227,7 +232,9 @@ impl StepReport {
     fn add_work(&mut self, other: &StepReport) {
         self.newton_iterations += other.newton_iterations;
         self.cg_iterations += other.cg_iterations;
+        self.factorizations += other.factorizations;
         self.timings += other.timings;
+        self.shift = self.shift.max(other.shift);
     }
 }
 
@@ -276,6 +283,11 @@ pub struct Integrator {
     direct_pattern: Option<Arc<DirectPattern>>,
     /// What contact did so far.
     pub contact_stats: ContactStats,
+    /// The share of inertia added to Newton's matrix on meshes with a complete factor, to
+    /// keep it positive definite (`solve_shifted`).
+    shift: f64,
+    /// The last shift that a failure had to be raised to: where the next failure starts.
+    needed_shift: f64,
 }
 
 impl Integrator {
@@ -290,6 +302,8 @@ impl Integrator {
             preconditioner: None,
             direct_pattern: None,
             contact_stats: ContactStats::default(),
+            shift: 0.0,
+            needed_shift: 0.0,
         }
     }
 
@@ -534,6 +548,106 @@ impl Integrator {
         report
     }
 
+    /// Whether the kept preconditioner should be rebuilt. A factor serves later iterations,
+    /// and later steps: the matrix changes little from one to the next, and a factorisation
+    /// costs several CG iterations. It is rebuilt once the iterations it has cost beyond
+    /// what it took when new add up to what building it cost (the rent-or-buy rule: never
+    /// more than twice the best choice made in hindsight).
+    fn preconditioner_is_stale(&self, n: usize) -> bool {
+        self.preconditioner.as_ref().is_none_or(|p| p.size != n || p.excess >= p.preconditioner.cost_in_iterations())
+    }
+
+    /// Solves Newton's system on a mesh with a complete factor with the exact matrix H plus
+    /// a shift s·M/h² (s = `self.shift`, a share of the inertia), s as small as keeps it
+    /// positive definite (Levenberg and Marquardt's regularisation, in the mass metric).
+    /// False, with nothing solved, if that takes more than `MAX_SHIFT`.
+    ///
+    /// A factor that fails (a pivot not positive) or a CG that meets negative curvature or
+    /// returns no descent doubles s (from `MIN_SHIFT`), or sets it to the last shift a
+    /// failure needed if that is more; the matrix is factored again only if the kept factor
+    /// was made for a smaller shift. After each solve the next iteration tries half the
+    /// shift with the same factor: a shift kept through a step slowed Newton to 30
+    /// iterations on a compressed sheet (`tests/conservation.rs`), where a shift is needed
+    /// for only an iteration or two. The need returns in jumps, from zero to about 3 within
+    /// an iteration on the 20 463-triangle drape, and climbing there by doubling failed 94
+    /// of 214 factorisations over its first 0.3 s; starting from the last need, 16 of 139
+    /// (CG iterations 4330 → 3713, CPU −17 %, the same Newton iterations).
+    ///
+    /// Fine meshes used to take the bounded matrix of `CompressedEdges::Within` throughout,
+    /// which scales the compressed edges' term at each vertex to at most 90 % of the
+    /// inertia. The bound guards against the shortest waves, where a compressed edge's
+    /// softening is largest, and inertia per vertex falls as the edge length squared: on the
+    /// 20 463-triangle drape nearly every free vertex was bounded, most to a fiftieth of its
+    /// softening, so the matrix was wrong in the long waves too and Newton converged
+    /// linearly (steps of a few µm for up to 30 iterations, the gradient not falling). The
+    /// exact matrix is positive definite in most of those iterations, and a shift makes it
+    /// so in most of the rest. Over the first 0.3 s of that drape: 1110 Newton iterations
+    /// with the bound, 781 with shifts of at most 0.4, 566 with at most 6.4.
+    fn solve_shifted(&mut self, exact: &SystemMatrix, direction: &mut [DVec3], solve: &mut Solve) -> bool {
+        let n = exact.fixed.len();
+        let mut rebuild = false;
+        let mut raised = false;
+        loop {
+            let shifted: Vec<f64> = exact.mass_diagonal.iter().map(|d| d * (1.0 + self.shift)).collect();
+            let system = SystemMatrix { mass_diagonal: &shifted, ..*exact };
+            // Doubles the shift, or takes the last one that had to be raised to; false once
+            // it is at its largest.
+            let needed = self.needed_shift;
+            let mut raise = |shift: &mut f64| {
+                if *shift >= MAX_SHIFT {
+                    return false;
+                }
+                *shift = (2.0 * *shift).max(needed).clamp(MIN_SHIFT, MAX_SHIFT);
+                raised = true;
+                true
+            };
+            if rebuild || self.preconditioner_is_stale(n) {
+                let factor = self.direct_factor(&system);
+                solve.report.factorizations += 1;
+                solve.timings.solve += lap(solve.clock);
+                match factor {
+                    Some(factor) => self.preconditioner = Some(CachedPreconditioner { shift: self.shift, ..CachedPreconditioner::new(n, factor) }),
+                    None if raise(&mut self.shift) => {
+                        rebuild = true;
+                        continue;
+                    }
+                    None => return false,
+                }
+            }
+            let cached = self.preconditioner.as_mut().expect("built above");
+            let cg = pcg(&system, &cached.preconditioner, solve.rhs, direction, solve.cg_tolerance, self.newton.cg_max_iterations);
+            solve.report.cg_iterations += cg.iterations;
+            solve.timings.solve += lap(solve.clock);
+            let descent = solve.rhs.iter().zip(direction.iter()).map(|(r, d)| r.dot(*d)).sum::<f64>() > 0.0;
+            if cg.negative_curvature || !descent {
+                if !raise(&mut self.shift) {
+                    return false;
+                }
+                // A factor made for at least this shift is already at hand.
+                rebuild = self.shift > cached.shift;
+                continue;
+            }
+            cached.record(&cg);
+            solve.report.shift = solve.report.shift.max(self.shift);
+            if raised {
+                self.needed_shift = self.shift;
+            }
+            // The next iteration tries half the shift, with the same factor.
+            self.shift = if self.shift / 2.0 < MIN_SHIFT { 0.0 } else { self.shift / 2.0 };
+            return true;
+        }
+    }
+
+    /// The complete factor of `system`, on the model's pattern (made once); None if it is
+    /// not positive definite (or the symbolic analysis failed).
+    fn direct_factor(&mut self, system: &SystemMatrix) -> Option<Preconditioner> {
+        if self.direct_pattern.as_ref().is_none_or(|p| !p.fits(system)) {
+            self.direct_pattern = DirectPattern::new(system).map(Arc::new);
+        }
+        let pattern = self.direct_pattern.clone()?;
+        DirectFactor::new(pattern, system).map(Preconditioner::Cholesky)
+    }
+
     /// Newton's method on the incremental potential Φ (plus contact), from `y` in place.
     fn newton(&mut self, step: &ImplicitStep, contacts: Option<&StepContacts>, y: &mut Vec<DVec3>, report: &mut StepReport) {
         let ImplicitStep { model, h, anchor, inertial } = *step;
@@ -561,6 +675,7 @@ impl Integrator {
         let mut previous_step: Option<f64> = None;
         let mut clock = Instant::now();
         let mut timings = StepTimings::default();
+        let mut bounded_throughout = false;
         for _ in 0..self.newton.max_iterations {
             self.forces.resize(n, DVec3::ZERO);
             model.forces(y, &mut self.forces);
@@ -605,15 +720,11 @@ impl Integrator {
             };
             // Newton's matrix takes the exact Hessian of the compressed edges: a buckling
             // cloth's softening is what makes Newton converge quadratically. Where it
-            // outweighs inertia and bending the matrix is indefinite, and CG meets a direction
-            // of negative curvature or returns no descent: the solve is then repeated with
-            // the softening bounded so that the matrix stays positive definite. With a
-            // complete factor (large meshes) the bounded matrix is used throughout: a factor
-            // kept over many iterations preconditions it well because the bound keeps it
-            // from changing much. At 20 463 triangles the exact matrix took 11 Newton
-            // iterations per step instead of 16 over the first 0.3 s of the drape, but 11 CG
-            // iterations per Newton iteration instead of 6: 9.1 CPU s per 10 ms simulated
-            // against 7.1.
+            // outweighs inertia and bending the matrix is indefinite. With the incomplete
+            // factor (coarse meshes) CG then meets a direction of negative curvature or
+            // returns no descent, and the solve is repeated with the softening bounded so
+            // that the matrix stays positive definite. With a complete factor (fine meshes)
+            // the exact matrix is shifted instead (`solve_shifted`).
             if let Some(c) = contacts {
                 couplings.clear();
                 c.couplings(y, &mut couplings);
@@ -625,62 +736,69 @@ impl Integrator {
                     c.add_hessian(y, anchor, k);
                 }
             };
-            let complete = self.newton.preconditioner.complete_factor(n);
-            assemble(&mut stiffness, if complete { CompressedEdges::Within(&softening) } else { CompressedEdges::Exact });
+            assemble(&mut stiffness, CompressedEdges::Exact);
             timings.forces += lap(&mut clock);
             let system = SystemMatrix { mass_diagonal: &mass_diagonal, stiffness: &stiffness, bending: bending.as_deref(), fixed: &model.fixed, couplings: &couplings };
-            let mut bounded_ready = false;
-            // A factor serves later iterations, and later steps: the matrix changes little
-            // from one to the next, and a factorisation costs several CG iterations. It is
-            // rebuilt once the iterations it has cost beyond what it took when new add up to
-            // what building it cost (the rent-or-buy rule: never more than twice the best
-            // choice made in hindsight).
-            let stale = self.preconditioner.as_ref().is_none_or(|p| p.size != n || p.excess >= p.preconditioner.cost_in_iterations());
-            if stale {
-                // Factors are made from the bounded matrix. Made from the exact one, the
-                // Euler strip's onset under BDF2 came 4.1 % above π²B/L² (1.5 % from the
-                // bounded one; the test allows 3 %): near the bifurcation the exact matrix is
-                // nearly singular, its incomplete factor breaks down and is shifted, and
-                // Newton's steps along the soft mode likely fell below the tolerance while
-                // the mode lagged.
-                let preconditioner = if complete {
-                    if self.direct_pattern.as_ref().is_none_or(|p| !p.fits(&system)) {
-                        self.direct_pattern = DirectPattern::new(&system).map(Arc::new);
+            if self.newton.preconditioner.complete_factor(n) {
+                let mut solve = Solve { rhs: &rhs, cg_tolerance, report: &mut *report, timings: &mut timings, clock: &mut clock };
+                if !bounded_throughout && !self.solve_shifted(&system, &mut direction, &mut solve) {
+                    // This step's remaining iterations take the bounded matrix, positive
+                    // definite, and a factor of it.
+                    bounded_throughout = true;
+                    self.preconditioner = None;
+                }
+                if bounded_throughout {
+                    assemble(&mut bounded, CompressedEdges::Within(&softening));
+                    timings.forces += lap(&mut clock);
+                    let system = SystemMatrix { stiffness: &bounded, ..system };
+                    if self.preconditioner_is_stale(n) {
+                        let preconditioner = self.direct_factor(&system).unwrap_or_else(|| system.preconditioner());
+                        report.factorizations += 1;
+                        self.preconditioner = Some(CachedPreconditioner::new(n, preconditioner));
+                        timings.solve += lap(&mut clock);
                     }
-                    match &self.direct_pattern {
-                        Some(pattern) => system.cholesky(pattern),
-                        None => system.preconditioner(),
-                    }
-                } else {
+                    let cached = self.preconditioner.as_mut().expect("built above");
+                    let cg = pcg(&system, &cached.preconditioner, &rhs, &mut direction, cg_tolerance, self.newton.cg_max_iterations);
+                    report.cg_iterations += cg.iterations;
+                    timings.solve += lap(&mut clock);
+                    cached.record(&cg);
+                }
+            } else {
+                let mut bounded_ready = false;
+                if self.preconditioner_is_stale(n) {
+                    // Factors are made from the bounded matrix. Made from the exact one, the
+                    // Euler strip's onset under BDF2 came 4.1 % above π²B/L² (1.5 % from the
+                    // bounded one; the test allows 3 %): near the bifurcation the exact
+                    // matrix is nearly singular, its incomplete factor breaks down and is
+                    // shifted, and Newton's steps along the soft mode likely fell below the
+                    // tolerance while the mode lagged.
                     assemble(&mut bounded, CompressedEdges::Within(&softening));
                     bounded_ready = true;
                     timings.forces += lap(&mut clock);
-                    SystemMatrix { stiffness: &bounded, ..system }.preconditioner()
-                };
-                self.preconditioner = Some(CachedPreconditioner { size: n, preconditioner, fresh_rate: None, excess: 0.0 });
-                timings.solve += lap(&mut clock);
-            }
-            let cached = self.preconditioner.as_mut().expect("built above");
-            let mut cg = pcg(&system, &cached.preconditioner, &rhs, &mut direction, cg_tolerance, self.newton.cg_max_iterations);
-            report.cg_iterations += cg.iterations;
-            timings.solve += lap(&mut clock);
-            let descent = gradient.iter().zip(&direction).map(|(g, d)| g.dot(*d)).sum::<f64>() < 0.0;
-            // (A bounded matrix is positive definite: a failure there is left to the line
-            // search and its steepest-descent fallback.)
-            if !complete && (cg.negative_curvature || !descent) {
-                if !bounded_ready {
-                    assemble(&mut bounded, CompressedEdges::Within(&softening));
-                    timings.forces += lap(&mut clock);
+                    let preconditioner = SystemMatrix { stiffness: &bounded, ..system }.preconditioner();
+                    report.factorizations += 1;
+                    self.preconditioner = Some(CachedPreconditioner::new(n, preconditioner));
+                    timings.solve += lap(&mut clock);
                 }
-                let system = SystemMatrix { mass_diagonal: &mass_diagonal, stiffness: &bounded, bending: bending.as_deref(), fixed: &model.fixed, couplings: &couplings };
-                cg = pcg(&system, &cached.preconditioner, &rhs, &mut direction, cg_tolerance, self.newton.cg_max_iterations);
+                let cached = self.preconditioner.as_mut().expect("built above");
+                let mut cg = pcg(&system, &cached.preconditioner, &rhs, &mut direction, cg_tolerance, self.newton.cg_max_iterations);
                 report.cg_iterations += cg.iterations;
                 timings.solve += lap(&mut clock);
+                let descent = gradient.iter().zip(&direction).map(|(g, d)| g.dot(*d)).sum::<f64>() < 0.0;
+                // (A bounded matrix is positive definite: a failure there is left to the
+                // line search and its steepest-descent fallback.)
+                if cg.negative_curvature || !descent {
+                    if !bounded_ready {
+                        assemble(&mut bounded, CompressedEdges::Within(&softening));
+                        timings.forces += lap(&mut clock);
+                    }
+                    let system = SystemMatrix { stiffness: &bounded, ..system };
+                    cg = pcg(&system, &cached.preconditioner, &rhs, &mut direction, cg_tolerance, self.newton.cg_max_iterations);
+                    report.cg_iterations += cg.iterations;
+                    timings.solve += lap(&mut clock);
+                }
+                cached.record(&cg);
             }
-            // Iterations per e-fold of residual reduction: comparable across tolerances.
-            let efolds = (-cg.relative_residual.max(1e-16).ln()).max(1.0);
-            let fresh_rate = *cached.fresh_rate.get_or_insert(cg.iterations as f64 / efolds);
-            cached.excess += (cg.iterations as f64 - fresh_rate * efolds).max(0.0);
             if all_free {
                 // The elastic Hessian annihilates translations, so adding a constant c to d
                 // changes only the mass term of H d. Choosing c so that Σ M (d + c) = −Σ g
@@ -776,6 +894,20 @@ const SOFTENING_SHARE: f64 = 0.9;
 /// is nearly flat.
 const EXTRAPOLATION: f64 = 8.0;
 
+/// The smallest and largest shifts `solve_shifted` adds, as shares of the inertia.
+const MIN_SHIFT: f64 = 0.05;
+const MAX_SHIFT: f64 = 6.4;
+
+/// One Newton iteration's linear solve: its right-hand side and tolerance, and where its
+/// work is counted.
+struct Solve<'a> {
+    rhs: &'a [DVec3],
+    cg_tolerance: f64,
+    report: &'a mut StepReport,
+    timings: &'a mut StepTimings,
+    clock: &'a mut Instant,
+}
+
 /// A preconditioner with what it was built for and how quick it made CG when new.
 struct CachedPreconditioner {
     /// Vertices of the matrix it was built from.
@@ -785,6 +917,22 @@ struct CachedPreconditioner {
     fresh_rate: Option<f64>,
     /// CG iterations spent beyond that rate since.
     excess: f64,
+    /// The shift of the matrix it was made from (`Integrator::solve_shifted`).
+    shift: f64,
+}
+
+impl CachedPreconditioner {
+    fn new(size: usize, preconditioner: Preconditioner) -> Self {
+        Self { size, preconditioner, fresh_rate: None, excess: 0.0, shift: 0.0 }
+    }
+
+    /// Counts a solve's iterations beyond the rate this preconditioner had when new.
+    fn record(&mut self, cg: &CgReport) {
+        // Iterations per e-fold of residual reduction: comparable across tolerances.
+        let efolds = (-cg.relative_residual.max(1e-16).ln()).max(1.0);
+        let fresh_rate = *self.fresh_rate.get_or_insert(cg.iterations as f64 / efolds);
+        self.excess += (cg.iterations as f64 - fresh_rate * efolds).max(0.0);
+    }
 }
 
 /// What one implicit step minimises over: Φ's inertial target x̃, the anchor x̂ of the

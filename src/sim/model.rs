@@ -484,20 +484,7 @@ impl Model {
             CompressedEdges::Dropped => vec![0.0; x.len()],
             CompressedEdges::Exact => vec![1.0; x.len()],
             CompressedEdges::Within(allowance) => {
-                let mut demand = vec![0.0; x.len()];
-                for tri in &self.rosettes {
-                    let (strain, _, lengths) = rosette_strain(tri, x);
-                    let tension = edge_tensions(tri, law.stress(strain));
-                    for p in 0..3 {
-                        if tension[p] < 0.0 {
-                            let (a, b) = edge_vertices(tri, p);
-                            let c = -2.0 * tension[p] / lengths[p];
-                            demand[a as usize] += c;
-                            demand[b as usize] += c;
-                        }
-                    }
-                }
-                demand.iter().zip(allowance).map(|(&d, &a)| if d <= a { 1.0 } else { a / d }).collect()
+                self.compressed_demand(x).iter().zip(allowance).map(|(&d, &a)| if d <= a { 1.0 } else { a / d }).collect()
             }
         };
         let add = |k: &mut BlockCsr, tri: &RosetteTriangle, blocks: &[DMat3; 6]| {
@@ -518,6 +505,26 @@ impl Model {
                 add(k, tri, b);
             }
         }
+    }
+
+    /// Each vertex's Σ 2|t|/l over the compressed edges it ends (N/m): the compressed
+    /// edges' geometric stiffness −(|t|/l)(I − uuᵀ) is at least −diag(demand) ⊗ I₃.
+    pub fn compressed_demand(&self, x: &[DVec3]) -> Vec<f64> {
+        let mut demand = vec![0.0; x.len()];
+        let Some(law) = &self.membrane_law else { return demand };
+        for tri in &self.rosettes {
+            let (strain, _, lengths) = rosette_strain(tri, x);
+            let tension = edge_tensions(tri, law.stress(strain));
+            for p in 0..3 {
+                if tension[p] < 0.0 {
+                    let (a, b) = edge_vertices(tri, p);
+                    let c = -2.0 * tension[p] / lengths[p];
+                    demand[a as usize] += c;
+                    demand[b as usize] += c;
+                }
+            }
+        }
+        demand
     }
 
     /// A zero matrix with the in-plane stiffness pattern.
