@@ -6,9 +6,8 @@
 //! part is stored as 3×3 blocks; the bending part is a scalar matrix that acts the same on
 //! x, y and z (its energy is ½ Σ Q_ab x_a·x_b), so it is stored once, not three times.
 
-use crate::sim::direct::{DirectFactor, DirectPattern};
+use crate::sim::direct::DirectFactor;
 use glam::{DMat3, DVec3, Mat3};
-use std::sync::Arc;
 
 /// Compressed sparse rows of 3×3 blocks with a fixed pattern.
 #[derive(Debug, Clone)]
@@ -223,15 +222,6 @@ impl SystemMatrix<'_> {
             }
         }
         Preconditioner::BlockJacobi(self.block_jacobi())
-    }
-
-    /// The complete Cholesky factor on `pattern` (made for this matrix's pattern), or the
-    /// incomplete one if it is not positive definite.
-    pub fn cholesky(&self, pattern: &Arc<DirectPattern>) -> Preconditioner {
-        match DirectFactor::new(pattern.clone(), self) {
-            Some(factor) => Preconditioner::Cholesky(factor),
-            None => self.preconditioner(),
-        }
     }
 
     /// Inverse 3×3 diagonal blocks: the block-Jacobi preconditioner.
@@ -614,6 +604,8 @@ pub fn pcg(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::direct::DirectPattern;
+    use std::sync::Arc;
 
     /// A chain of `n` vertices: springs between neighbours (anisotropic 3×3 blocks) and a
     /// scalar second-difference "bending" matrix coupling vertices two apart.
@@ -723,8 +715,7 @@ mod tests {
         let a = SystemMatrix { mass_diagonal: &mass, stiffness: &k, bending: Some(&q), fixed: &fixed, couplings: &[] };
         let pattern = Arc::new(DirectPattern::new(&a).expect("symbolic analysis"));
         assert!(pattern.fits(&a));
-        let preconditioner = a.cholesky(&pattern);
-        assert!(matches!(preconditioner, Preconditioner::Cholesky(_)), "the factorisation failed");
+        let preconditioner = Preconditioner::Cholesky(DirectFactor::new(pattern, &a).expect("the factorisation failed"));
         let b: Vec<DVec3> = (0..n).map(|i| DVec3::new((i as f64).cos(), -1.0, (i % 4) as f64)).collect();
         let mut x = vec![DVec3::ZERO; n];
         let report = pcg(&a, &preconditioner, &b, &mut x, 1e-10, 50);
