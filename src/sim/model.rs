@@ -509,7 +509,7 @@ impl Model {
 
     /// Each vertex's Σ 2|t|/l over the compressed edges it ends (N/m): the compressed
     /// edges' geometric stiffness −(|t|/l)(I − uuᵀ) is at least −diag(demand) ⊗ I₃.
-    pub fn compressed_demand(&self, x: &[DVec3]) -> Vec<f64> {
+    fn compressed_demand(&self, x: &[DVec3]) -> Vec<f64> {
         let mut demand = vec![0.0; x.len()];
         let Some(law) = &self.membrane_law else { return demand };
         for tri in &self.rosettes {
