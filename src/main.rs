@@ -4,7 +4,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 use rosette::app::viewer::ViewerOptions;
 use rosette::render;
-use rosette::scene::{RunOptions, Scene, load_scene, preset, run_scene};
+use rosette::scene::{RunOptions, Scene, StepRecord, load_scene, preset, run_scene};
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
@@ -36,6 +36,10 @@ enum Command {
         /// Drape scenes: write the final shadow outline as CSV (angle_deg, radius_m).
         #[arg(long, value_name = "FILE.csv")]
         outline: Option<String>,
+        /// Write one CSV row per step: its Newton, CG and factorisation counts, Newton's
+        /// shift, the cloth's RMS speed, the CPU time so far and the step's time by phase.
+        #[arg(long, value_name = "FILE.csv")]
+        step_log: Option<std::path::PathBuf>,
         #[command(flatten)]
         screenshot: ScreenshotArgs,
     },
@@ -115,7 +119,8 @@ fn main() -> ExitCode {
                 colormap: None,
                 wireframe: false,
             };
-            let code = run("cusick-drape", &[], None, None, None, &shot);
+            let outputs = RunOutputs { metrics: None, outline: None, step_log: None };
+            let code = run("cusick-drape", &[], None, &outputs, &shot);
             eprintln!("wrote cusick-drape.png; `rosette run PRESET --screenshot FILE.png` for other scenes");
             code
         }
@@ -135,8 +140,9 @@ fn main() -> ExitCode {
             }
         },
         Some(Command::Chart { out, quick }) => chart(out, quick),
-        Some(Command::Run { preset, overrides, duration, metrics, outline, screenshot }) => {
-            run(&preset, &overrides, duration, metrics.as_deref(), outline.as_deref(), &screenshot)
+        Some(Command::Run { preset, overrides, duration, metrics, outline, step_log, screenshot }) => {
+            let outputs = RunOutputs { metrics: metrics.as_deref(), outline: outline.as_deref(), step_log: step_log.as_deref() };
+            run(&preset, &overrides, duration, &outputs, &screenshot)
         }
     }
 }
@@ -170,14 +176,15 @@ fn view(options: ViewerOptions) -> ExitCode {
     }
 }
 
-fn run(
-    spec: &str,
-    overrides: &[String],
-    duration: Option<f64>,
-    metrics_out: Option<&str>,
-    outline_out: Option<&str>,
-    shot: &ScreenshotArgs,
-) -> ExitCode {
+/// Where `rosette run` writes what it measured.
+struct RunOutputs<'a> {
+    metrics: Option<&'a str>,
+    outline: Option<&'a str>,
+    step_log: Option<&'a std::path::Path>,
+}
+
+fn run(spec: &str, overrides: &[String], duration: Option<f64>, outputs: &RunOutputs, shot: &ScreenshotArgs) -> ExitCode {
+    let (metrics_out, outline_out) = (outputs.metrics, outputs.outline);
     let config = match load_scene(spec, overrides) {
         Ok((config, _)) => config,
         Err(e) => {
@@ -218,7 +225,28 @@ fn run(
             bar.set_position((fraction * 1000.0) as u64);
         }
     };
-    let (metrics, error) = run_scene(&mut scene, &name, RunOptions { duration, progress: Some(&mut on_progress) });
+    // The step log is opened before the run, so that a bad path fails at once, and
+    // written as the run goes, so that a run stopped early keeps its rows.
+    let mut step_log = match outputs.step_log.map(open_step_log).transpose() {
+        Ok(log) => log,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let mut log_error: Option<std::io::Error> = None;
+    let mut on_step = |record: &StepRecord| {
+        if let (Some(out), None) = (step_log.as_mut(), &log_error) {
+            log_error = writeln!(out, "{}", record.csv_row()).err();
+        }
+    };
+    let options = RunOptions { duration, progress: Some(&mut on_progress), on_step: Some(&mut on_step) };
+    let (metrics, error) = run_scene(&mut scene, &name, options);
+    if let Some(e) = log_error.or_else(|| step_log.as_mut().and_then(|out| out.flush().err())) {
+        let path = outputs.step_log.expect("a log was written").display();
+        eprintln!("error: cannot write the step log to {path}: {e}");
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
@@ -252,6 +280,14 @@ fn run(
         }
         None => ExitCode::SUCCESS,
     }
+}
+
+/// Creates the step log and writes its header.
+fn open_step_log(path: &std::path::Path) -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
+    let file = std::fs::File::create(path).with_context(|| format!("cannot create the step log {}", path.display()))?;
+    let mut out = std::io::BufWriter::new(file);
+    writeln!(out, "{}", StepRecord::CSV_HEADER).with_context(|| format!("cannot write the step log {}", path.display()))?;
+    Ok(out)
 }
 
 fn write_outline(scene: &Scene, path: &str) -> anyhow::Result<()> {

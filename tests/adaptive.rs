@@ -58,7 +58,7 @@ fn adaptive_cantilever_matches_the_elastica_in_fewer_steps() {
         let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
         let (config, _) = load_scene("cantilever", &overrides).unwrap();
         let mut scene = Scene::build(config.clone()).unwrap();
-        let (m, error) = run_scene(&mut scene, "cantilever", RunOptions { duration: None, progress: None });
+        let (m, error) = run_scene(&mut scene, "cantilever", RunOptions::default());
         assert!(error.is_none(), "{error:?}");
         (config, m)
     };

@@ -9,7 +9,7 @@ use rosette::scene::{RunOptions, Scene, SceneConfig, load_scene, run_scene};
 fn run(preset: &str, overrides: &[String]) -> (SceneConfig, serde_json::Value) {
     let (config, _) = load_scene(preset, overrides).unwrap_or_else(|e| panic!("{e}"));
     let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
-    let (metrics, error) = run_scene(&mut scene, preset, RunOptions { duration: None, progress: None });
+    let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
     assert!(error.is_none(), "{error:?}");
     (config, metrics.measures)
 }
@@ -217,11 +217,11 @@ fn arc_follows_a_nonlinear_moment_curvature_curve() {
 fn settled_cantilever_stops_early_with_the_same_answer() {
     let (config, _) = load_scene("cantilever", &[]).unwrap();
     let mut settling = Scene::build(config.clone()).unwrap();
-    let (early, _) = run_scene(&mut settling, "cantilever", RunOptions { duration: None, progress: None });
+    let (early, _) = run_scene(&mut settling, "cantilever", RunOptions::default());
     let mut full_config = config;
     full_config.scene.settle_speed = None;
     let mut full = Scene::build(full_config).unwrap();
-    let (complete, _) = run_scene(&mut full, "cantilever", RunOptions { duration: None, progress: None });
+    let (complete, _) = run_scene(&mut full, "cantilever", RunOptions::default());
     assert_eq!(early.settled, Some(true));
     assert_eq!(complete.settled, None);
     assert!(early.simulated_seconds < 0.7 * complete.simulated_seconds, "{} s vs {} s", early.simulated_seconds, complete.simulated_seconds);

@@ -10,7 +10,7 @@ fn run(preset: &str, overrides: &[&str]) -> (SceneConfig, serde_json::Value) {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let (config, _) = load_scene(preset, &overrides).unwrap_or_else(|e| panic!("{e}"));
     let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
-    let (metrics, error) = run_scene(&mut scene, preset, RunOptions { duration: None, progress: None });
+    let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
     assert!(error.is_none(), "{error:?}");
     (config, metrics.measures)
 }

@@ -207,6 +207,33 @@ fn outline_csv_of_a_drape() {
     assert!(text(&out.stderr).contains("not a drape scene"), "{}", text(&out.stderr));
 }
 
+/// `--step-log` writes one row per step, whose Newton and CG counts add up to the run's
+/// totals and whose times follow the steps; a path that cannot be created is bad input.
+#[test]
+fn step_log_has_a_row_per_step() {
+    let path = metrics_path("steps").with_extension("csv");
+    let out = rosette(&["run", "cantilever", "--duration", "0.1", "--step-log", path.to_str().unwrap(), "--metrics", "-"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let metrics: Value = serde_json::from_str(&text(&out.stdout)).unwrap();
+    let csv = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"));
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    assert_eq!(rows.len() as u64, metrics["steps"].as_u64().unwrap());
+    assert!(rows.iter().all(|r| r.len() == header.len()));
+    let sum = |name: &str| rows.iter().map(|r| r[column(name)]).sum::<f64>();
+    assert_eq!(sum("newton"), metrics["newton_iterations"].as_f64().unwrap());
+    assert_eq!(sum("cg"), metrics["cg_iterations"].as_f64().unwrap());
+    let (time, step) = (column("time_s"), column("step"));
+    assert!(rows.windows(2).all(|w| w[1][time] > w[0][time] && w[1][step] == w[0][step] + 1.0));
+    let simulated = metrics["simulated_seconds"].as_f64().unwrap();
+    assert!((rows.last().unwrap()[time] - simulated).abs() < 1e-9);
+    let missing = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("no-such-dir").join("steps.csv");
+    assert_bad_input(&["run", "cantilever", "--duration", "0.01", "--step-log", missing.to_str().unwrap()], &["step log", "no-such-dir"]);
+}
+
 #[test]
 fn runs_shear_buckling() {
     run_bundled("shear-buckling");

@@ -40,7 +40,7 @@ fn a_fast_fall_onto_a_thin_plate_does_not_tunnel() {
         let dt = if integrator == "symplectic-euler" { 0.5 * probe.model.explicit_step_limit(&probe.state.x) } else { 0.01 };
         overrides.push(format!("solver.dt={dt}"));
         let mut scene = build("tablecloth", &overrides);
-        let (metrics, error) = run_scene(&mut scene, "fall", RunOptions { duration: None, progress: None });
+        let (metrics, error) = run_scene(&mut scene, "fall", RunOptions::default());
         assert!(error.is_none(), "{integrator}: {error:?}");
         let thickness = scene.config.contact.thickness;
         let penetration = metrics.max_penetration.unwrap();
@@ -78,7 +78,7 @@ fn a_cloth_pulled_over_a_sharp_edge_stays_outside() {
         let end: Vec<u32> = (0..x.len() as u32).filter(|&v| x[v as usize].x > 0.2 - 1e-9).collect();
         assert!(!end.is_empty());
         scene.model.drive(&end, &x, Motion::Linear { velocity: DVec3::new(0.0, 0.0, -0.5), start: 0.0, stop: 0.5 });
-        let (metrics, error) = run_scene(&mut scene, "edge", RunOptions { duration: None, progress: None });
+        let (metrics, error) = run_scene(&mut scene, "edge", RunOptions::default());
         assert!(error.is_none(), "{integrator}: {error:?}");
         let thickness = scene.config.contact.thickness;
         let penetration = metrics.max_penetration.unwrap();
@@ -173,11 +173,11 @@ fn folds_dropped_on_a_ball_never_pass_through_each_other() {
         ])
     };
     let mut scene = build("tablecloth", &overrides(true));
-    let (metrics, error) = run_scene(&mut scene, "crumple", RunOptions { duration: None, progress: None });
+    let (metrics, error) = run_scene(&mut scene, "crumple", RunOptions::default());
     assert!(error.is_none(), "{error:?}");
     assert_eq!(metrics.self_intersections, Some(0), "{:?}", metrics.contact_events);
     assert!(metrics.max_penetration.unwrap() < 0.1 * scene.config.contact.thickness);
     let mut unprotected = build("tablecloth", &overrides(false));
-    let (metrics, _) = run_scene(&mut unprotected, "crumple", RunOptions { duration: None, progress: None });
+    let (metrics, _) = run_scene(&mut unprotected, "crumple", RunOptions::default());
     assert!(metrics.self_intersections.unwrap() > 0, "the cloth never touched itself: the test proves nothing");
 }

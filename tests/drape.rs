@@ -11,7 +11,7 @@ use rosette::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_sc
 fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Metrics) {
     let (config, _) = load_scene(preset, overrides).unwrap_or_else(|e| panic!("{e}"));
     let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
-    let (metrics, error) = run_scene(&mut scene, preset, RunOptions { duration: None, progress: None });
+    let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
     assert!(error.is_none(), "{preset} {overrides:?}: {error:?}");
     (config, metrics)
 }

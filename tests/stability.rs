@@ -78,7 +78,7 @@ fn explicit_drape_above_its_limit_is_caught_not_swept() {
     let mut scene = Scene::build(config).unwrap();
     let limit = scene.model.explicit_step_limit(&scene.state.x);
     assert!(0.003 > 5.0 * limit, "the test needs dt far above the limit {limit:e}");
-    let (metrics, error) = run_scene(&mut scene, "cusick-drape-30", RunOptions { duration: Some(1.0), progress: None });
+    let (metrics, error) = run_scene(&mut scene, "cusick-drape-30", RunOptions { duration: Some(1.0), ..Default::default() });
     let message = error.expect("the explicit drape must diverge").to_string();
     println!("{} steps: {message}", metrics.steps);
     assert!(metrics.steps < 20 && !metrics.stable, "{} steps", metrics.steps);

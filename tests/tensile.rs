@@ -18,7 +18,7 @@ fn run(preset: &str, overrides: &[&str]) -> (SceneConfig, Metrics) {
     let (config, _) = load_scene(preset, &overrides).unwrap_or_else(|e| panic!("{preset} {overrides:?}: {e}"));
     let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{preset}: {e}"));
     let started = std::time::Instant::now();
-    let (metrics, error) = run_scene(&mut scene, preset, RunOptions { duration: None, progress: None });
+    let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
     assert!(error.is_none(), "{preset} {overrides:?} diverged: {error:?}");
     assert!(metrics.stable);
     eprintln!(

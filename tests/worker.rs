@@ -50,7 +50,7 @@ fn worker_steps_match_direct_steps_bit_for_bit() {
     // And against the headless runner (`rosette run`) over the same simulated time.
     let mut scene = Scene::build(config).unwrap();
     let duration = Some(n as f64 * scene.integrator.dt);
-    let (metrics, error) = run_scene(&mut scene, "euler-buckling", RunOptions { duration, progress: None });
+    let (metrics, error) = run_scene(&mut scene, "euler-buckling", RunOptions { duration, ..Default::default() });
     assert!(error.is_none());
     assert_eq!(metrics.steps, n);
     assert_eq!(bits(&snapshot.positions), bits(&scene.state.x), "worker and run_scene differ");
@@ -122,6 +122,28 @@ fn scene_stops_at_its_duration() {
     assert_eq!(done.steps, 5);
     let stress_strain = done.measures["stress_strain"].as_array().expect("tensile measures");
     assert!(!stress_strain.is_empty());
+}
+
+#[test]
+fn a_settled_cloth_pauses_where_the_headless_run_stops() {
+    // The cantilever settles about 1.3 s into its 3 s: play pauses there, at the step where
+    // `rosette run` stops, instead of stepping a resting strip to the end.
+    let config = preset("cantilever");
+    let worker = spawn("cantilever", config.clone());
+    worker.send(Command::Play);
+    let done = worker.wait_for(WAIT, |s| s.finished);
+    assert!(!done.playing);
+    let settled_at = done.settled_at.expect("the strip settles");
+    assert!(done.time < config.scene.duration - 0.5, "paused at {} s of {}", done.time, config.scene.duration);
+    let mut scene = Scene::build(config).unwrap();
+    let (metrics, error) = run_scene(&mut scene, "cantilever", RunOptions::default());
+    assert!(error.is_none());
+    assert_eq!((metrics.settle_time, metrics.steps), (Some(settled_at), done.steps));
+    assert_eq!(bits(&done.positions), bits(&scene.state.x), "worker and run_scene differ");
+    // Play again runs on past the settling, to the scene's end.
+    worker.send(Command::Play);
+    let resumed = worker.wait_for(WAIT, |s| s.steps > done.steps + 5);
+    assert!(resumed.playing && resumed.settled_at == Some(settled_at));
 }
 
 #[test]

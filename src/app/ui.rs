@@ -185,8 +185,14 @@ impl ViewerUi {
             }
             ui.separator();
             ui.monospace(format!("t = {:.3} / {} s   step {}", snapshot.time, snapshot.duration, snapshot.steps));
-            if snapshot.finished {
-                ui.label("(end of scene: Play continues)");
+            match (snapshot.finished, snapshot.settled_at) {
+                (true, Some(t)) => {
+                    ui.label(format!("(settled at t = {t:.2} s: Play continues)"));
+                }
+                (true, None) => {
+                    ui.label("(end of scene: Play continues)");
+                }
+                _ => {}
             }
             if snapshot.playing && snapshot.stats.real_time_factor > 0.0 && snapshot.stats.real_time_factor < 0.95 {
                 ui.colored_label(Color32::from_rgb(230, 160, 40), format!("{:.2}× real time", snapshot.stats.real_time_factor));

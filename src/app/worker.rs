@@ -12,7 +12,7 @@
 //! time follows wall time, and when it is slower it runs flat out and reports the
 //! real-time factor. Nothing here depends on a GUI crate, so tests drive it directly.
 
-use crate::scene::{Scene, SceneConfig, load_scene, preset::FabricConfig};
+use crate::scene::{Scene, SceneConfig, SettleWatch, load_scene, preset::FabricConfig};
 use crate::sim::{Integrator, IntegratorKind, State};
 use glam::DVec3;
 use std::collections::VecDeque;
@@ -128,8 +128,11 @@ pub struct Snapshot {
     /// The scene's `scene.duration`, s.
     pub duration: f64,
     pub playing: bool,
-    /// The scene has reached its duration (playing further continues past it).
+    /// The scene has reached its duration or settled (playing further continues past it).
     pub finished: bool,
+    /// When the cloth settled (`scene.settle_speed`), if it has: play then paused there, so
+    /// that a resting cloth costs no more steps.
+    pub settled_at: Option<f64>,
     pub stats: Stats,
     /// The rig's measurements (`Scene::measures`), for live plots.
     pub measures: Arc<serde_json::Value>,
@@ -252,7 +255,11 @@ struct WorkerState {
     mailbox: Arc<Mailbox>,
     on_publish: Option<Box<dyn Fn() + Send>>,
     playing: bool,
+    /// Play has paused at the scene's end; further play runs past it.
     finished: bool,
+    /// Play has paused where the cloth settled; further play runs on to the end.
+    paused_settled: bool,
+    settle: SettleWatch,
     error: Option<String>,
     drag: Option<Drag>,
     serial: u64,
@@ -269,6 +276,7 @@ struct WorkerState {
 
 impl WorkerState {
     fn new(scene_name: String, scene: Scene, mailbox: Arc<Mailbox>, on_publish: Option<Box<dyn Fn() + Send>>) -> Self {
+        let settle = SettleWatch::new(&scene);
         let mut state = Self {
             config: Arc::new(scene.config.clone()),
             triangles: Arc::new(scene.model.triangles.clone()),
@@ -281,6 +289,8 @@ impl WorkerState {
             on_publish,
             playing: false,
             finished: false,
+            paused_settled: false,
+            settle,
             error: None,
             drag: None,
             serial: 0,
@@ -335,8 +345,23 @@ impl WorkerState {
             }
             if self.playing && self.seconds_ahead() <= 0.0 {
                 self.step_once();
-                if self.scene.state.time >= self.scene.config.scene.duration - 1e-6 * self.scene.integrator.dt && !self.finished {
+                let end = self.scene.state.time >= self.scene.config.scene.duration - 1e-6 * self.scene.integrator.dt;
+                // A settled cloth pauses, as `rosette run` stops: it would only rest at the
+                // cost of a solve per step. Not while the mouse holds it, and only once:
+                // Play after the pause runs on to the scene's end.
+                let settled = self.drag.is_none() && {
+                    let rms = self.settle.rms_speed(&self.scene);
+                    self.settle.observe(&self.scene, rms).is_some()
+                };
+                if self.drag.is_some() {
+                    self.settle.interrupt();
+                }
+                if end && !self.finished {
                     self.finished = true;
+                    self.playing = false;
+                }
+                if settled && !self.paused_settled {
+                    self.paused_settled = true;
                     self.playing = false;
                 }
             }
@@ -423,6 +448,8 @@ impl WorkerState {
         self.props = Arc::new(solids.iter().map(|p| p.surface_mesh(0.0)).collect());
         self.generation += 1;
         self.finished = false;
+        self.paused_settled = false;
+        self.settle = SettleWatch::new(&self.scene);
         self.error = None;
         self.drag = None;
         self.timings.clear();
@@ -565,7 +592,8 @@ impl WorkerState {
             steps: self.scene.state.steps,
             duration: self.scene.config.scene.duration,
             playing: self.playing,
-            finished: self.finished,
+            finished: self.finished || self.paused_settled,
+            settled_at: self.settle.settled_at,
             stats: self.stats(),
             measures: Arc::new(self.scene.measures()),
             error: self.error.clone(),

@@ -176,7 +176,7 @@ impl Case {
         let config = self.config(dt)?;
         let mut scene = Scene::build(config.clone()).map_err(|e| e.to_string())?;
         let cpu = cpu_time::ThreadTime::now();
-        let (metrics, error) = run_scene(&mut scene, self.problem.name(), RunOptions { duration: None, progress: None });
+        let (metrics, error) = run_scene(&mut scene, self.problem.name(), RunOptions::default());
         outcome.cpu_seconds = cpu.elapsed().as_secs_f64();
         if let Some(e) = error {
             outcome.diverged = true;

@@ -9,7 +9,7 @@ pub mod run;
 pub mod strip;
 
 pub use preset::{SceneConfig, SceneKind, load_scene};
-pub use run::{Metrics, RunOptions, run_scene};
+pub use run::{Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
 
 use crate::sim::contact::{ContactModel, ContactSettings};
 use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};

@@ -57,11 +57,130 @@ pub struct Metrics {
     pub measures: serde_json::Value,
 }
 
+/// How to run a scene; `RunOptions::default()` runs it for its own duration, silently.
+#[derive(Default)]
 pub struct RunOptions<'a> {
     /// Simulated time, s; the scene's own when `None`.
     pub duration: Option<f64>,
     /// Called with the fraction done, now and then.
     pub progress: Option<&'a mut dyn FnMut(f64)>,
+    /// Called after every step that stood, with what it cost.
+    pub on_step: Option<&'a mut dyn FnMut(&StepRecord)>,
+}
+
+/// One step of a run: what it cost and how fast the cloth moved (`rosette run --step-log`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepRecord {
+    /// Steps taken so far, this one included.
+    pub step: u64,
+    /// Simulated time at the end of the step, s.
+    pub time: f64,
+    /// The step's Δt, s.
+    pub dt: f64,
+    pub newton_iterations: usize,
+    pub cg_iterations: usize,
+    pub factorizations: usize,
+    /// The largest shift Newton's matrix took, as a share of the inertia (0 where none).
+    pub shift: f64,
+    /// Whether Newton stopped at its iteration limit.
+    pub newton_unconverged: bool,
+    /// Mass-weighted RMS speed of the cloth after the step, m/s.
+    pub rms_speed: f64,
+    /// Process CPU seconds since the run began.
+    pub cpu_seconds: f64,
+    /// Wall seconds of the step by phase.
+    pub timings: StepTimings,
+}
+
+impl StepRecord {
+    /// The CSV header matching `csv_row`.
+    pub const CSV_HEADER: &'static str =
+        "step,time_s,dt_s,newton,cg,factorizations,shift,newton_unconverged,rms_speed_m_s,cpu_s,forces_s,solve_s,contact_s";
+
+    pub fn csv_row(&self) -> String {
+        let t = &self.timings;
+        format!(
+            "{},{:.6},{:e},{},{},{},{},{},{:e},{:.4},{:.5},{:.5},{:.5}",
+            self.step,
+            self.time,
+            self.dt,
+            self.newton_iterations,
+            self.cg_iterations,
+            self.factorizations,
+            self.shift,
+            self.newton_unconverged as u8,
+            self.rms_speed,
+            self.cpu_seconds,
+            t.forces,
+            t.solve,
+            t.contact
+        )
+    }
+}
+
+/// Watches a scene for settling (`scene.settle_speed`): the cloth's mass-weighted RMS
+/// speed stays below that speed for `scene.settle_window` seconds, once every prescribed
+/// motion and the gravity ramp are done. `rosette run` then stops, and the viewer pauses.
+#[derive(Debug, Clone)]
+pub struct SettleWatch {
+    speed: Option<f64>,
+    window: f64,
+    gravity_ramp: Option<f64>,
+    total_mass: f64,
+    /// Start of the current run of slow steps.
+    slow_since: Option<f64>,
+    /// When the cloth settled: the start of the slow run that lasted the window.
+    pub settled_at: Option<f64>,
+}
+
+impl SettleWatch {
+    pub fn new(scene: &Scene) -> Self {
+        let s = &scene.config.scene;
+        Self {
+            speed: s.settle_speed,
+            window: s.settle_window,
+            gravity_ramp: s.gravity_ramp,
+            total_mass: scene.model.mass.iter().sum(),
+            slow_since: None,
+            settled_at: None,
+        }
+    }
+
+    /// Whether the scene asks for settling to be watched.
+    pub fn watched(&self) -> bool {
+        self.speed.is_some()
+    }
+
+    /// The mass-weighted RMS speed √(2 KE / M), m/s.
+    pub fn rms_speed(&self, scene: &Scene) -> f64 {
+        (2.0 * scene.state.kinetic_energy(&scene.model) / self.total_mass).sqrt()
+    }
+
+    /// Restarts the count of slow steps (something outside the scene, such as the mouse,
+    /// holds the cloth).
+    pub fn interrupt(&mut self) {
+        self.slow_since = None;
+    }
+
+    /// Takes the state after a step, whose RMS speed is `rms`; the time the cloth settled
+    /// once it has.
+    pub fn observe(&mut self, scene: &Scene, rms: f64) -> Option<f64> {
+        let limit = self.speed?;
+        if self.settled_at.is_some() {
+            return self.settled_at;
+        }
+        let t = scene.state.time;
+        let loads_done = self.gravity_ramp.is_none_or(|ramp| t >= ramp);
+        if rms < limit && scene.model.motions_finished(t) && loads_done {
+            let since = *self.slow_since.get_or_insert(t);
+            if t - since >= self.window {
+                self.settled_at = Some(since);
+            }
+        } else {
+            self.slow_since = None;
+        }
+        self.settled_at
+    }
 }
 
 /// Steps `scene` to the end of its duration. A divergence stops the run with the last good
@@ -71,6 +190,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let dt = scene.integrator.dt;
     let end_time = scene.state.time + duration;
     let mut progress = options.progress;
+    let mut on_step = options.on_step;
     let wall = Instant::now();
     let cpu = cpu_time::ProcessTime::now();
     let start_time = scene.state.time;
@@ -78,43 +198,42 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let mut step_time = StepTimings::default();
     let mut rejected = 0u64;
     let mut error = None;
-    let settle_speed = scene.config.scene.settle_speed;
-    let settle_window = scene.config.scene.settle_window;
-    let total_mass: f64 = scene.model.mass.iter().sum();
-    // Start of the current run of slow steps, and when the cloth settled.
-    let (mut slow_since, mut settle_time): (Option<f64>, Option<f64>) = (None, None);
+    let mut settle = SettleWatch::new(scene);
     let mut k = 0u64;
     // Steps until the end time is reached (a fixed Δt that does not divide the duration
     // ends past it).
     while scene.state.time < end_time - 1e-6 * scene.integrator.dt {
         k += 1;
-        match scene.step() {
-            Ok(report) => {
-                newton += report.newton_iterations as u64;
-                cg += report.cg_iterations as u64;
-                factorizations += report.factorizations as u64;
-                step_time += report.timings;
-                rejected += report.rejected as u64;
-            }
+        let report = match scene.step() {
+            Ok(report) => report,
             Err(e) => {
                 error = Some(e);
                 break;
             }
+        };
+        newton += report.newton_iterations as u64;
+        cg += report.cg_iterations as u64;
+        factorizations += report.factorizations as u64;
+        step_time += report.timings;
+        rejected += report.rejected as u64;
+        let rms = settle.rms_speed(scene);
+        if let Some(f) = on_step.as_deref_mut() {
+            f(&StepRecord {
+                step: scene.state.steps,
+                time: scene.state.time,
+                dt: report.dt,
+                newton_iterations: report.newton_iterations,
+                cg_iterations: report.cg_iterations,
+                factorizations: report.factorizations,
+                shift: report.shift,
+                newton_unconverged: report.newton_unconverged,
+                rms_speed: rms,
+                cpu_seconds: cpu.elapsed().as_secs_f64(),
+                timings: report.timings,
+            });
         }
-        if let Some(limit) = settle_speed {
-            let t = scene.state.time;
-            // Mass-weighted RMS speed: √(2 KE / M).
-            let rms = (2.0 * scene.state.kinetic_energy(&scene.model) / total_mass).sqrt();
-            let loads_done = scene.config.scene.gravity_ramp.is_none_or(|ramp| t >= ramp);
-            if rms < limit && scene.model.motions_finished(t) && loads_done {
-                let since = *slow_since.get_or_insert(t);
-                if t - since >= settle_window {
-                    settle_time = Some(since);
-                    break;
-                }
-            } else {
-                slow_since = None;
-            }
+        if settle.observe(scene, rms).is_some() {
+            break;
         }
         if let (Some(p), true) = (progress.as_deref_mut(), k.is_multiple_of(16)) {
             p(((scene.state.time - start_time) / duration).min(1.0));
@@ -135,8 +254,8 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         cpu_seconds_per_simulated_second: per_second,
         cpu_seconds_per_10ms: per_second * 0.01,
         stable: error.is_none(),
-        settled: settle_speed.map(|_| settle_time.is_some()),
-        settle_time,
+        settled: settle.watched().then_some(settle.settled_at.is_some()),
+        settle_time: settle.settled_at,
         error: error.as_ref().map(|e| e.to_string()),
         max_penetration: scene.model.contact.as_ref().map(|_| scene.integrator.contact_stats.max_penetration),
         self_intersections: scene
