@@ -119,8 +119,7 @@ fn main() -> ExitCode {
                 colormap: None,
                 wireframe: false,
             };
-            let outputs = RunOutputs { metrics: None, outline: None, step_log: None };
-            let code = run("cusick-drape", &[], None, &outputs, &shot);
+            let code = run("cusick-drape", &[], None, &RunOutputs::default(), &shot);
             eprintln!("wrote cusick-drape.png; `rosette run PRESET --screenshot FILE.png` for other scenes");
             code
         }
@@ -176,7 +175,8 @@ fn view(options: ViewerOptions) -> ExitCode {
     }
 }
 
-/// Where `rosette run` writes what it measured.
+/// Where `rosette run` writes what it measured (nothing by default).
+#[derive(Default)]
 struct RunOutputs<'a> {
     metrics: Option<&'a str>,
     outline: Option<&'a str>,
