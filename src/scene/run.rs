@@ -100,7 +100,7 @@ impl StepRecord {
     pub fn csv_row(&self) -> String {
         let t = &self.timings;
         format!(
-            "{},{:.6},{:e},{},{},{},{},{},{:e},{:.4},{:.5},{:.5},{:.5}",
+            "{},{},{:e},{},{},{},{},{},{:.4e},{:.4},{:.3e},{:.3e},{:.3e}",
             self.step,
             self.time,
             self.dt,
