@@ -242,11 +242,6 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, outputs: &RunOut
     };
     let options = RunOptions { duration, progress: Some(&mut on_progress), on_step: Some(&mut on_step) };
     let (metrics, error) = run_scene(&mut scene, &name, options);
-    if let Some(e) = log_error.or_else(|| step_log.as_mut().and_then(|out| out.flush().err())) {
-        let path = outputs.step_log.expect("a log was written").display();
-        eprintln!("error: cannot write the step log to {path}: {e}");
-        return ExitCode::from(EXIT_BAD_INPUT);
-    }
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
@@ -256,6 +251,13 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, outputs: &RunOut
     }
     if let Some(Err(e)) = outline_out.map(|path| write_outline(&scene, path)) {
         eprintln!("error: {e:#}");
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
+    // Checked once the run's metrics are saved: a log that fails mid-run (a full disk)
+    // does not cost the run's results.
+    if let Some(e) = log_error.or_else(|| step_log.as_mut().and_then(|out| out.flush().err())) {
+        let path = outputs.step_log.expect("a log was written").display();
+        eprintln!("error: cannot write the step log to {path}: {e}");
         return ExitCode::from(EXIT_BAD_INPUT);
     }
     if metrics_out.is_none() {
