@@ -260,24 +260,27 @@ pub fn read_stability(path: &Path) -> Result<Vec<StabilityRow>, ChartError> {
         .collect()
 }
 
-const DRAPE_REFERENCE_HEADER: &str = "edge_length,dt,triangles,cpu_seconds,drape_coefficient";
+const DRAPE_REFERENCE_HEADER: &str = "edge_length,dt,triangles,cpu_seconds,drape_coefficient,model_revision";
 
 /// The cached drape reference, if the file holds one made with `case`'s mesh and step.
 pub fn read_drape_reference(path: &Path, case: &Case) -> Option<f64> {
     let super::Step::Seconds(dt) = case.step else { return None };
     let fields = records(path, DRAPE_REFERENCE_HEADER).ok()?.pop()?;
-    let same = fields[0].parse::<f64>().ok()? == case.edge_length && fields[1].parse::<f64>().ok()? == dt;
+    let same = fields[0].parse::<f64>().ok()? == case.edge_length
+        && fields[1].parse::<f64>().ok()? == dt
+        && fields[5].parse::<u32>().ok()? == crate::sim::MODEL_REVISION;
     same.then(|| fields[4].parse().ok()).flatten()
 }
 
 pub fn write_drape_reference(path: &Path, outcome: &Outcome) -> Result<(), ChartError> {
     let text = format!(
-        "{DRAPE_REFERENCE_HEADER}\n{},{},{},{},{}\n",
+        "{DRAPE_REFERENCE_HEADER}\n{},{},{},{},{},{}\n",
         outcome.case.edge_length,
         outcome.dt,
         outcome.triangles,
         number(Some(outcome.cpu_seconds)),
-        number(outcome.measure)
+        number(outcome.measure),
+        crate::sim::MODEL_REVISION
     );
     write(path, &text)
 }

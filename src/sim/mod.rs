@@ -9,6 +9,11 @@ pub mod mesh;
 pub mod model;
 pub mod sparse;
 
+/// Revision of the model's physics: raised by every change that alters simulated results,
+/// so that results cached from an older model (the chart's drape reference) are recomputed.
+/// 2: hinges against mesh-scale oscillation in the bending energy.
+pub const MODEL_REVISION: u32 = 2;
+
 pub use curve::PiecewiseLinear;
 pub use integrate::{AdaptiveStep, Integrator, IntegratorKind, NewtonSettings, PreconditionerChoice, State, StepError, StepReport, StepTimings};
 pub use material::{BendingStiffness, Fabric, FabricError, MembraneLaw};

@@ -113,6 +113,10 @@ impl BlockCsr {
 }
 
 impl ScalarCsr {
+    pub fn vertex_count(&self) -> usize {
+        self.row_start.len() - 1
+    }
+
     pub fn with_pattern(n: usize, pairs: impl Iterator<Item = (u32, u32)>) -> Self {
         let (row_start, cols) = pattern(n, pairs);
         let values = vec![0.0; cols.len()];
