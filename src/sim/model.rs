@@ -838,26 +838,15 @@ fn bending_patches(mesh: &Mesh, warp_angle: f64, rigid: &[bool]) -> Result<(Vec<
     let on_clamp_line: Vec<bool> = (0..n)
         .map(|v| rigid[v] && vertex_triangles[v].iter().any(|&t| mesh.triangles[t as usize].iter().any(|&u| !rigid[u as usize])))
         .collect();
-    // One fit per edge, whose gradient its triangles share, and the hinge across it; edges in
-    // a fixed order, so that Q sums the same way in every run.
-    let mut edges: Vec<[u32; 2]> = edge_owner.keys().copied().collect();
-    edges.sort_unstable();
-    let mut gradient_of_edge: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::with_capacity(edges.len());
-    let mut hinges = Vec::new();
-    for edge in edges {
-        let owners = &edge_owner[&edge];
+    // One gradient stencil per edge, shared by its triangles.
+    let mut gradient_of_edge: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
+    for (&edge, owners) in &edge_owner {
         let midpoint = 0.5 * (warp[edge[0] as usize] + warp[edge[1] as usize]);
         let inside_clamp = rigid[edge[0] as usize] && rigid[edge[1] as usize];
         let usable = |v: u32| if inside_clamp { rigid[v as usize] } else { !rigid[v as usize] || on_clamp_line[v as usize] };
-        let fit = edge_fit(mesh, &vertex_triangles, &warp, edge, midpoint, scale, usable)
+        let stencil = edge_gradient_stencil(mesh, &vertex_triangles, &warp, edge, midpoint, scale, usable)
             .ok_or(ModelError::SingularBendingStencil { triangle: owners[0].0 })?;
-        if let [(t0, k0), (t1, k1)] = owners[..] {
-            let wings = [mesh.triangles[t0][k0], mesh.triangles[t1][k1]];
-            if !edge.iter().chain(&wings).any(|&v| rigid[v as usize]) {
-                hinges.extend(Hinge::new(&fit, &warp, edge, wings));
-            }
-        }
-        gradient_of_edge.insert(edge, fit.gradient());
+        gradient_of_edge.insert(edge, stencil);
     }
     let mut patches = Vec::with_capacity(mesh.triangles.len());
     for (t, tri) in mesh.triangles.iter().enumerate() {
@@ -882,47 +871,61 @@ fn bending_patches(mesh: &Mesh, warp_angle: f64, rigid: &[bool]) -> Result<(Vec<
         let (vertices, weights) = weights.into_iter().unzip();
         patches.push(BendingPatch { vertices, weights, area, interior });
     }
+    // Two half hinges per interior edge, one on each triangle's fitted Hessian; edges in a
+    // fixed order, so that Q sums the same way in every run.
+    let mut edges: Vec<[u32; 2]> = edge_owner.keys().copied().collect();
+    edges.sort_unstable();
+    let mut hinges = Vec::new();
+    for edge in edges {
+        if let [(t0, k0), (t1, k1)] = edge_owner[&edge][..] {
+            let wings = [mesh.triangles[t0][k0], mesh.triangles[t1][k1]];
+            if !edge.iter().chain(&wings).any(|&v| rigid[v as usize]) {
+                hinges.extend([t0, t1].into_iter().filter_map(|t| Hinge::new(&patches[t], &warp, edge, wings)));
+            }
+        }
+    }
     Ok((patches, hinges))
 }
 
 /// A stabilisation of the fitted bending stencils against mesh-scale oscillation.
 ///
-/// The fits that give the edge gradients average over a ring or more, so a field that zigzags
-/// from vertex to vertex can have a nearly flat fit everywhere and almost no bending energy:
-/// on the paper's drape mesh about 7 % of the bending operator's modes are such
+/// The fits that give the edge gradients average over a ring or more, so a deflection that
+/// zigzags from vertex to vertex can have nearly flat fits everywhere and almost no bending
+/// energy: on the paper's drape mesh about 7 % of the bending operator's modes are such
 /// oscillations, with under 1 % (down to 0.16 %) of the continuum's stiffness B k⁴ at their
-/// wavenumber. A compressed sheet buckles into them at the scale of the mesh (hourglass
-/// modes, as in under-integrated finite elements). Each interior edge therefore adds the
-/// energy of a hinge, the paper's cantilever across the edge, acting only on what the fit
-/// cannot represent:
+/// wavenumber, and on square grids a zigzag along the grid has 3 % of it. A compressed sheet
+/// buckles into them at the scale of the mesh (hourglass modes, as in under-integrated
+/// finite elements). Each interior edge therefore adds the energy of a hinge, the paper's
+/// cantilever across the edge, acting only on what the fitted curvature does not explain:
 ///
 /// ```text
-///        c            J = [∂r/∂m] is the jump of the normal derivative across edge ab of the
-///       / \           piecewise-linear r = x − x̃ (x̃ the edge's quadratic fit evaluated at
-///      a---b  → m     a, b, c, d), and E = ½ B_m (J/d)² A with d the distance between the
-///       \ /           triangles' centroids along m, A a third of their areas and B_m the
-///        d            flexural rigidity across the edge (paper eq. 3 from the plate's D).
+///        c            J is the jump of the normal slope across edge ab of the piecewise-
+///       / \           linear surface through a, b, c, d, and J_T the same jump of the
+///      a---b  → m     quadratic with triangle T's fitted Hessian H_T. Each of the edge's
+///       \ /           two triangles T holds half of E = ½ B_m ((J − J_T)/d)² A, with d the
+///        d            distance between the triangles' centroids along m, A a third of
+///                     their areas and B_m the flexural rigidity across the edge (eq. 3).
 /// ```
 ///
-/// Any quadratic surface is fitted exactly, so r = 0 and the term adds nothing where the
-/// fitted stencils are exact: it leaves the patch test, the cylindrical and twisted
-/// curvatures and the rigid motions as they were, and stiffens only the oscillations.
-/// What a one-ring fit interpolates, it cannot see: on square grids a zigzag along a grid
-/// line keeps 3 % of a plate's stiffness (README, The model).
+/// H_T is exact on any quadratic surface, so there J = J_T and the term adds nothing: it
+/// leaves the patch test, the cylindrical and twisted curvatures and the rigid motions as
+/// they were, and stiffens only what the fitted stencils miss: the oscillations, and the
+/// shortfall of the fitted stencils on features a few edges wide, which they bend too
+/// easily (unit test `smooth_bumps_bend_as_a_plate`).
 struct Hinge {
-    /// The fit's points and each one's weight in J.
+    /// The patch's vertices and each one's weight in J − J_T.
     vertices: Vec<u32>,
     stencil: Vec<f64>,
     /// Unit normal of the edge in the warp frame, towards wing d.
     normal: DVec2,
-    /// A/d², the hinge's energy per unit rigidity and squared J.
+    /// A/(2d²), the half hinge's energy per unit rigidity and squared J − J_T.
     weight: f64,
 }
 
 impl Hinge {
-    /// The hinge of edge `e` between the triangles (e, wings[0]) and (e, wings[1]), on the
-    /// edge's fit; None if either triangle is degenerate.
-    fn new(fit: &EdgeFit, warp: &[DVec2], e: [u32; 2], wings: [u32; 2]) -> Option<Self> {
+    /// The half hinge of edge `e` between the triangles (e, wings[0]) and (e, wings[1]) on
+    /// `patch`, the fitted Hessian of one of them; None if either triangle is degenerate.
+    fn new(patch: &BendingPatch, warp: &[DVec2], e: [u32; 2], wings: [u32; 2]) -> Option<Self> {
         let p = |v: u32| warp[v as usize];
         let along = p(e[1]) - p(e[0]);
         let mut normal = DVec2::new(along.y, -along.x).normalize();
@@ -943,8 +946,18 @@ impl Hinge {
         let (s0, s1) = (normal_slope(wings[0])?, normal_slope(wings[1])?);
         // J over (e0, e1, wing0, wing1).
         let jump = [(e[0], s1[0] - s0[0]), (e[1], s1[1] - s0[1]), (wings[0], -s0[2]), (wings[1], s1[2])];
-        let mut vertices = fit.points.clone();
-        let mut stencil = vec![0.0; vertices.len()];
+        // J of ½ Hᵢⱼ uᵢuⱼ (u from the edge's midpoint; J ignores linear terms), per unit
+        // Voigt component of H.
+        let midpoint = 0.5 * (p(e[0]) + p(e[1]));
+        let mut jump_of_hessian = [0.0; 3];
+        for &(v, j) in &jump {
+            let u = p(v) - midpoint;
+            jump_of_hessian[0] += j * 0.5 * u.x * u.x;
+            jump_of_hessian[1] += j * 0.5 * u.y * u.y;
+            jump_of_hessian[2] += j * u.x * u.y;
+        }
+        let mut vertices = patch.vertices.clone();
+        let mut stencil: Vec<f64> = patch.weights.iter().map(|w| -(0..3).map(|i| jump_of_hessian[i] * w[i]).sum::<f64>()).collect();
         for &(h, j) in &jump {
             match vertices.iter().position(|&v| v == h) {
                 Some(i) => stencil[i] += j,
@@ -953,18 +966,15 @@ impl Hinge {
                     stencil.push(j);
                 }
             }
-            for (i, (_, value)) in fit.value_at(p(h)).enumerate() {
-                stencil[i] -= j * value;
-            }
         }
         let centroid = |wing: u32| (p(e[0]) + p(e[1]) + p(wing)) / 3.0;
         let distance = (centroid(wings[1]) - centroid(wings[0])).dot(normal);
         let area = |wing: u32| 0.5 * along.perp_dot(p(wing) - p(e[0])).abs();
-        let weight = (area(wings[0]) + area(wings[1])) / 3.0 / (distance * distance);
+        let weight = 0.5 * (area(wings[0]) + area(wings[1])) / 3.0 / (distance * distance);
         Some(Self { vertices, stencil, normal, weight })
     }
 
-    /// Its stiffness: β B_m A/d².
+    /// Its stiffness: β B_m A/(2d²).
     fn stiffness(&self, bending: &BendingStiffness) -> f64 {
         HINGE_STABILIZATION * bending.rigidity_at(self.normal.to_angle()) * self.weight
     }
@@ -973,37 +983,11 @@ impl Hinge {
 /// β, the hinges' share of the full hinge rigidity.
 const HINGE_STABILIZATION: f64 = 1.0;
 
-/// A least-squares quadratic f ≈ c0 + c1 u + c2 v + c3 u² + c4 uv + c5 v² through the
-/// values at the vertices around an edge, (u, v) the offsets from the edge's midpoint over
-/// `scale`: each point's value enters the coefficients with weights `coefficients[i]`.
-/// Exact for quadratics.
-struct EdgeFit {
-    points: Vec<u32>,
-    coefficients: Vec<[f64; 6]>,
-    midpoint: DVec2,
-    scale: f64,
-}
-
-impl EdgeFit {
-    /// Weights c_v (2-vectors) such that Σ_v c_v f_v is the fit's gradient at the midpoint.
-    fn gradient(&self) -> Vec<(u32, DVec2)> {
-        self.points.iter().zip(&self.coefficients).map(|(&v, c)| (v, DVec2::new(c[1], c[2]) / self.scale)).collect()
-    }
-
-    /// Weights of each point's value in the fit's value at `p`.
-    fn value_at(&self, p: DVec2) -> impl Iterator<Item = (u32, f64)> + '_ {
-        let basis = quadratic_basis((p - self.midpoint) / self.scale);
-        self.points.iter().zip(&self.coefficients).map(move |(&v, c)| (v, (0..6).map(|i| basis[i] * c[i]).sum()))
-    }
-}
-
-fn quadratic_basis(d: DVec2) -> [f64; 6] {
-    [1.0, d.x, d.y, d.x * d.x, d.x * d.y, d.y * d.y]
-}
-
-/// The quadratic fit around `edge`. The neighbourhood grows ring by ring until the fit is
-/// well posed (near corners one ring lies on two lines, which no quadratic fit can resolve).
-fn edge_fit(
+/// Weights c_v (2-vectors) such that Σ_v c_v f_v is the gradient at `midpoint` of the
+/// least-squares quadratic through the values f_v at the vertices around `edge`; exact for
+/// quadratics. The neighbourhood grows ring by ring until the fit is well posed (near
+/// corners one ring lies on two lines, which no quadratic fit can resolve).
+fn edge_gradient_stencil(
     mesh: &Mesh,
     vertex_triangles: &[Vec<u32>],
     warp: &[DVec2],
@@ -1011,7 +995,7 @@ fn edge_fit(
     midpoint: DVec2,
     scale: f64,
     usable: impl Fn(u32) -> bool,
-) -> Option<EdgeFit> {
+) -> Option<Vec<(u32, DVec2)>> {
     let mut points: Vec<u32> = edge.to_vec();
     for _ring in 0..3 {
         let mut grown = points.clone();
@@ -1024,17 +1008,17 @@ fn edge_fit(
         grown.sort_unstable();
         grown.dedup();
         points = grown;
-        if let Some(coefficients) = quadratic_fit_weights(&points, warp, midpoint, scale) {
-            return Some(EdgeFit { points, coefficients, midpoint, scale });
+        if let Some(stencil) = quadratic_gradient_weights(&points, warp, midpoint, scale) {
+            return Some(stencil);
         }
     }
     None
 }
 
-/// Weights of each point's value in the six coefficients of the weighted least-squares
-/// quadratic over `points` (offsets from `midpoint` over `scale`); None if the fit is
-/// ill-posed.
-fn quadratic_fit_weights(points: &[u32], warp: &[DVec2], midpoint: DVec2, scale: f64) -> Option<Vec<[f64; 6]>> {
+/// Least-squares fit of f ≈ c0 + c1 u + c2 v + c3 u² + c4 uv + c5 v² with (u, v) the
+/// offsets from `midpoint` over `scale`, weighted towards near points; returns the weights
+/// of each point's value in (c1, c2)/scale. None if the fit is ill-posed.
+fn quadratic_gradient_weights(points: &[u32], warp: &[DVec2], midpoint: DVec2, scale: f64) -> Option<Vec<(u32, DVec2)>> {
     if points.len() < 6 {
         return None;
     }
@@ -1044,7 +1028,7 @@ fn quadratic_fit_weights(points: &[u32], warp: &[DVec2], midpoint: DVec2, scale:
             let d = (warp[v as usize] - midpoint) / scale;
             // Near points count more, so the fit is as local as the data allow.
             let weight = 1.0 / (1.0 + d.length_squared());
-            (quadratic_basis(d), weight)
+            ([1.0, d.x, d.y, d.x * d.x, d.x * d.y, d.y * d.y], weight)
         })
         .collect();
     let mut normal = [[0.0f64; 6]; 6];
@@ -1056,7 +1040,16 @@ fn quadratic_fit_weights(points: &[u32], warp: &[DVec2], midpoint: DVec2, scale:
         }
     }
     let inverse = invert_spd6(normal)?;
-    Some(rows.iter().map(|(r, w)| std::array::from_fn(|row| (0..6).map(|j| inverse[row][j] * r[j]).sum::<f64>() * w)).collect())
+    Some(
+        points
+            .iter()
+            .zip(&rows)
+            .map(|(&v, (r, w))| {
+                let coefficient = |row: usize| (0..6).map(|j| inverse[row][j] * r[j]).sum::<f64>() * w;
+                (v, DVec2::new(coefficient(1), coefficient(2)) / scale)
+            })
+            .collect(),
+    )
 }
 
 /// Inverse of a symmetric positive definite 6×6 matrix by Cholesky; None when a pivot is
@@ -1178,8 +1171,9 @@ fn bending_matrix(n: usize, patches: &[BendingPatch], hinges: &[Hinge], stiffnes
     let pairs = patches.iter().flat_map(|p| {
         p.vertices.iter().flat_map(move |&a| p.vertices.iter().map(move |&b| (a, b))).collect::<Vec<_>>()
     });
-    // The hinges add no entries: a hinge's points are its edge's fit (one ring or more around
-    // the edge, wings included), all of which are in the patch of either triangle.
+    // The hinges add no entries: a half hinge's points are its triangle's patch and the
+    // edge's two wings, which that patch already holds (the shared edge's fit spans a ring
+    // around the edge, both wings included).
     let mut q = ScalarCsr::with_pattern(n, pairs);
     for BendingPatch { vertices: vs, weights: ws, area, .. } in patches {
         for (a, wa) in vs.iter().zip(ws) {
@@ -1404,9 +1398,9 @@ pub(crate) mod tests {
         }
     }
 
-    /// The hinges read zero on every quadratic surface (which the edge fits reproduce), on
-    /// any triangulation and warp angle, so they leave constant curvatures to the fitted
-    /// stencils.
+    /// The hinges read zero on every quadratic surface (whose curvature each triangle's fitted
+    /// Hessian reproduces), on any triangulation and warp angle, so they leave constant
+    /// curvatures to the fitted stencils.
     #[test]
     fn hinges_vanish_on_quadratic_surfaces() {
         let f = |p: DVec2| 0.3 + 2.0 * p.x - p.y + 40.0 * p.x * p.x - 25.0 * p.x * p.y + 10.0 * p.y * p.y;
@@ -1493,8 +1487,8 @@ pub(crate) mod tests {
 
     /// No deflection is much softer than a plate: the softest one, relative to c_min, is at
     /// least a quarter of the continuum's bound of 1 on every triangulation (a discrete
-    /// operator is softer at the mesh scale; the fitted stencils alone reach 0.04–0.14 there,
-    /// the hinges lift that to 0.44–1.6).
+    /// operator may be softer at the mesh scale; the fitted stencils alone reach 0.04–0.14
+    /// there, with the hinges the softest deflection is the smooth one, at 9–12).
     #[test]
     fn no_mesh_scale_deflection_escapes_bending() {
         let fabric = test_fabric();
@@ -1504,6 +1498,42 @@ pub(crate) mod tests {
             let model = Model::new(&mesh, &fabric, 0.3, opts).unwrap();
             let softest = softest_deflection(&mesh, &model);
             assert!(softest > 0.25, "{pattern:?}: the softest deflection has {softest:.3} of the plate's bending energy");
+        }
+    }
+
+    /// A Gaussian bump w = a·exp(−r²/σ²) four edges wide (σ = 4h) stores within 10 % of the
+    /// plate energy ½ ∫ D:∇∇w:∇∇w (computed from the exact Hessian by quadrature), on every
+    /// triangulation; the fitted stencils alone store 14 % too little there.
+    #[test]
+    fn smooth_bumps_bend_as_a_plate() {
+        let fabric = test_fabric();
+        let opts = PhysicsOptions { membrane: false, gravity: DVec3::ZERO, ..Default::default() };
+        let (warp, h, sigma, a) = (0.3f64, 0.005, 0.02, 0.001);
+        let centre = DVec2::new(0.1, 0.1);
+        for pattern in [Pattern::Regular, Pattern::Alternating, Pattern::Equilateral, Pattern::Jittered] {
+            let mesh = Mesh::rectangle(0.2, 0.2, h, pattern, 11).unwrap();
+            let model = Model::new(&mesh, &fabric, warp, opts).unwrap();
+            let x = deformed(&model, |p| p.extend(a * (-(p - centre).length_squared() / (sigma * sigma)).exp()));
+            let d = model.bending_stiffness.voigt();
+            let (n, cell) = (400, 0.2 / 400.0);
+            let rotation = DMat2::from_angle(-warp);
+            let mut plate = 0.0;
+            for i in 0..n {
+                for j in 0..n {
+                    let p = DVec2::new((i as f64 + 0.5) * cell, (j as f64 + 0.5) * cell) - centre;
+                    let e = a * (-p.length_squared() / (sigma * sigma)).exp() / sigma.powi(4);
+                    let hessian = DMat2::from_cols(
+                        e * DVec2::new(4.0 * p.x * p.x - 2.0 * sigma * sigma, 4.0 * p.x * p.y),
+                        e * DVec2::new(4.0 * p.x * p.y, 4.0 * p.y * p.y - 2.0 * sigma * sigma),
+                    );
+                    // In the warp frame.
+                    let hw = rotation * hessian * rotation.transpose();
+                    let k = [hw.x_axis.x, hw.y_axis.y, hw.y_axis.x];
+                    plate += 0.5 * (0..3).map(|r| (0..3).map(|c| d[r][c] * k[r] * k[c]).sum::<f64>()).sum::<f64>() * cell * cell;
+                }
+            }
+            let ratio = model.bending_energy(&x) / plate;
+            assert!((ratio - 1.0).abs() < 0.1, "{pattern:?}: the bump stores {ratio:.3} of the plate's energy");
         }
     }
 }
