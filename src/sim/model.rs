@@ -304,11 +304,11 @@ impl Model {
     fn build_bending(&mut self, rigid: &[bool]) -> Result<(), ModelError> {
         let mesh = Mesh { rest: self.rest.clone(), triangles: self.triangles.clone() };
         let (patches, hinges) = bending_patches(&mesh, self.warp_angle, rigid)?;
-        let q = bending_matrix(self.rest.len(), &patches, &hinges, &self.bending_stiffness);
+        let (q, hinge_values) = bending_matrix(self.rest.len(), &patches, &hinges, &self.bending_stiffness);
         if let Some(nonlinear) = &mut self.bending_curve {
             nonlinear.contributions = triangle_contributions(&q, &patches, &self.bending_stiffness);
             let mut hinge_part = q.clone();
-            hinge_part.values = hinge_matrix_values(&q, &hinges, &self.bending_stiffness);
+            hinge_part.values = hinge_values;
             symmetrize_with_zero_row_sums(&mut hinge_part);
             nonlinear.hinges = Some(hinge_part);
         }
@@ -362,7 +362,7 @@ impl Model {
     fn bending_energy(&self, x: &[DVec3]) -> f64 {
         let Some(q) = &self.bending else { return 0.0 };
         match &self.bending_curve {
-            None => 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>(),
+            None => quadratic_energy(q, x),
             Some(NonlinearBending { curve, hinges, .. }) => {
                 let b_ref = self.bending_stiffness.d11;
                 let fitted: f64 = self
@@ -373,8 +373,7 @@ impl Model {
                         patch.area * b_ref * curve.integral(kappa) / curve.initial_slope()
                     })
                     .sum();
-                let hinge = hinges.as_ref().map_or(0.0, |h| 0.5 * h.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>());
-                fitted + hinge
+                fitted + hinges.as_ref().map_or(0.0, |h| quadratic_energy(h, x))
             }
         }
     }
@@ -401,14 +400,7 @@ impl Model {
             return Some(std::borrow::Cow::Borrowed(q));
         };
         // The secant matrix starts from the hinges' part, which stays linear.
-        let mut secant = match hinges {
-            Some(h) => h.clone(),
-            None => {
-                let mut zero = q.clone();
-                zero.values.fill(0.0);
-                zero
-            }
-        };
+        let mut secant = hinges.clone().expect("build_bending sets the hinges with Q");
         for (patch, entries) in self.bending_patches.iter().zip(contributions) {
             let s = self.bending_secant(curve, &patch.hessian(x));
             for &(slot, value) in entries {
@@ -639,6 +631,11 @@ impl Model {
     pub fn max_membrane_stiffness(&self) -> f64 {
         self.membrane_law.as_ref().map_or(0.0, |l| l.max_stiffness())
     }
+}
+
+/// ½ Σ Q_ab x_a·x_b, J.
+fn quadratic_energy(q: &ScalarCsr, x: &[DVec3]) -> f64 {
+    0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>()
 }
 
 /// f −= Q x for an energy ½ Σ Q_ab x_a·x_b whose rows sum to zero, written as
@@ -1165,8 +1162,8 @@ fn hinge_matrix_values(q: &ScalarCsr, hinges: &[Hinge], stiffness: &BendingStiff
 }
 
 /// Q = Σ_T A_T Wᵀ 𝔻 W + Σ_hinges k sᵀs, the constant Hessian of the quadratic bending
-/// energy.
-fn bending_matrix(n: usize, patches: &[BendingPatch], hinges: &[Hinge], stiffness: &BendingStiffness) -> ScalarCsr {
+/// energy, and the hinges' part of its values (unsymmetrised).
+fn bending_matrix(n: usize, patches: &[BendingPatch], hinges: &[Hinge], stiffness: &BendingStiffness) -> (ScalarCsr, Vec<f64>) {
     let d = stiffness.voigt();
     let pairs = patches.iter().flat_map(|p| {
         p.vertices.iter().flat_map(move |&a| p.vertices.iter().map(move |&b| (a, b))).collect::<Vec<_>>()
@@ -1190,11 +1187,11 @@ fn bending_matrix(n: usize, patches: &[BendingPatch], hinges: &[Hinge], stiffnes
         }
     }
     let hinge_values = hinge_matrix_values(&q, hinges, stiffness);
-    for (value, h) in q.values.iter_mut().zip(hinge_values) {
+    for (value, h) in q.values.iter_mut().zip(&hinge_values) {
         *value += h;
     }
     symmetrize_with_zero_row_sums(&mut q);
-    q
+    (q, hinge_values)
 }
 
 /// Makes `q` exactly symmetric, with rows that sum to exactly zero (the energy ignores
