@@ -263,7 +263,7 @@ impl Preconditioner {
         }
     }
 
-    fn apply(&self, r: &[DVec3], z: &mut [DVec3]) {
+    pub(crate) fn apply(&self, r: &[DVec3], z: &mut [DVec3]) {
         match self {
             Preconditioner::BlockJacobi(blocks) => {
                 for i in 0..r.len() {
