@@ -700,6 +700,7 @@ impl Integrator {
                 timings.contact += lap(&mut clock);
             }
             let norm = gradient.iter().map(|g| g.length_squared()).sum::<f64>().sqrt();
+            let rhs: Vec<DVec3> = gradient.iter().map(|g| -*g).collect();
             // Newton stops at a step under the tolerance. Where the next step promises to
             // be one, it is taken with the last preconditioner instead of being assembled
             // and solved for: while Newton converges the step shrinks as the gradient does,
@@ -713,7 +714,6 @@ impl Integrator {
                 && norm < 0.5 * before
                 && full * norm / before < tolerance
             {
-                let rhs: Vec<DVec3> = gradient.iter().map(|g| -*g).collect();
                 cached.preconditioner.apply(&rhs, &mut direction);
                 if all_free {
                     keep_momentum(&mass_diagonal, &gradient, &mut direction);
@@ -731,7 +731,6 @@ impl Integrator {
                 }
             }
             let bending = model.bending_newton_matrix(y);
-            let rhs: Vec<DVec3> = gradient.iter().map(|g| -*g).collect();
             let cg_tolerance = if self.newton.forcing {
                 // Eisenstat and Walker's safeguard against tightening too fast, 0.9·η²_{k−1},
                 // only acts above 0.1, which this term never exceeds.
