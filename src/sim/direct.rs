@@ -7,9 +7,11 @@
 //! 20 000). The complete factor of a recent matrix leaves CG only the change since then
 //! and the contact couplings to resolve. Its pattern (in-plane one-ring, bending stencil,
 //! fixed vertices) is the model's for the whole run, so the ordering and symbolic analysis
-//! are done once and each factorisation is numeric only.
+//! are done once and each factorisation is numeric only. faer factors; the triangular
+//! solves with its supernodal factor run on two threads (`supernodal`).
 
 use crate::sim::sparse::{SystemMatrix, merge_rows};
+use crate::sim::supernodal::SolvePlan;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -17,12 +19,14 @@ use faer::{Conj, MatMut, Par, Side};
 use glam::DVec3;
 use std::sync::Arc;
 
-/// faer factors and solves on one thread. Its supernodes on cloth meshes are small, and on
-/// this 2-core machine its rayon mode was slower at every size measured (the first two
-/// steps of the drape, two threads, wall time: at 19 791 triangles solve 0.45 s against
-/// 0.36 s sequential, 0.60 against 0.50 s in all; at 79 169 triangles 4.67 against
-/// 3.7–4.05 s, and a parallel factorisation with sequential solves 3.7–4.1 s). The other
-/// thread still runs the sparse products and the incomplete factor's parts.
+/// faer factors on one thread. Its supernodes on cloth meshes are small, and on this
+/// 2-core machine its rayon mode was slower at every size measured (the first two steps
+/// of the drape, two threads, wall time: at 19 791 triangles solve 0.45 s against 0.36 s
+/// sequential, 0.60 against 0.50 s in all; at 79 169 triangles 4.67 against 3.7–4.05 s,
+/// and a parallel factorisation with sequential solves 3.7–4.1 s; on 2026-12-01, one
+/// factorisation at 20 463 triangles took 350–370 ms on two threads against 245–260 ms on
+/// one). Its solves are left to `SolvePlan`, which splits the elimination tree instead;
+/// faer solves only the simplicial factors it picks for small matrices.
 const PARALLELISM: Par = Par::Seq;
 
 /// Where each stored entry of the lower triangle comes from.
@@ -46,6 +50,9 @@ pub struct DirectPattern {
     row_idx: Vec<u32>,
     sources: Vec<Source>,
     symbolic: SymbolicCholesky<u32>,
+    /// The two-thread triangular solves' plan (None: faer's simplicial factor, solved by
+    /// faer).
+    plan: Option<SolvePlan>,
     /// The fixed vertices it was built for.
     fixed: Vec<bool>,
 }
@@ -98,7 +105,8 @@ impl DirectPattern {
         let size = 3 * n;
         let pattern = SymbolicSparseColMatRef::new_checked(size, size, &col_ptr, None, &row_idx);
         let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, Default::default(), Default::default()).ok()?;
-        Some(Self { col_ptr, row_idx, sources, symbolic, fixed: a.fixed.to_vec() })
+        let plan = SolvePlan::new(&symbolic);
+        Some(Self { col_ptr, row_idx, sources, symbolic, plan, fixed: a.fixed.to_vec() })
     }
 
     /// Whether this pattern is that of `a` (the same vertices fixed).
@@ -132,10 +140,12 @@ impl DirectFactor {
     /// Factors `a` (without its contact couplings) on `pattern`; None if it is not
     /// positive definite.
     pub fn new(pattern: Arc<DirectPattern>, a: &SystemMatrix) -> Option<Self> {
+        use rayon::prelude::*;
         let k = a.stiffness;
         let values: Vec<f32> = pattern
             .sources
-            .iter()
+            .par_iter()
+            .with_min_len(1 << 14)
             .map(|s| {
                 if s.block == u32::MAX && s.bending == u32::MAX && s.mass == u32::MAX {
                     return if s.a == s.b { 1.0 } else { 0.0 };
@@ -181,6 +191,10 @@ impl DirectFactor {
 
     /// z = (LLᵀ)⁻¹ r.
     pub fn solve(&self, r: &[DVec3], z: &mut [DVec3]) {
+        if let Some(plan) = &self.pattern.plan {
+            plan.solve(&self.values, |i| r[i / 3][i % 3] as f32, |i, v| z[i / 3][i % 3] = v as f64);
+            return;
+        }
         let symbolic = &self.pattern.symbolic;
         let mut flat: Vec<f32> = r.iter().flat_map(|v| v.to_array().map(|c| c as f32)).collect();
         let size = flat.len();

@@ -334,14 +334,15 @@ impl Model {
     pub fn potential_energy(&self, x: &[DVec3]) -> f64 {
         let mut energy = 0.0;
         if let Some(law) = &self.membrane_law {
-            for tri in &self.rosettes {
-                let (strain, _, _) = rosette_strain(tri, x);
-                energy += tri.area * law.energy(strain);
-            }
+            energy += sum_of(self.rosettes.len(), |t| {
+                let tri = &self.rosettes[t];
+                tri.area * law.energy(rosette_strain(tri, x).0)
+            });
         }
         energy += self.bending_energy(x);
         if self.options.gravity != DVec3::ZERO {
-            energy -= x.iter().zip(&self.mass).map(|(p, m)| m * self.options.gravity.dot(*p)).sum::<f64>();
+            let g = self.options.gravity;
+            energy -= sum_of(x.len(), |i| self.mass[i] * g.dot(x[i]));
         }
         energy
     }
@@ -449,15 +450,30 @@ impl Model {
     ///         e2
     /// ```
     fn add_membrane_forces(&self, x: &[DVec3], f: &mut [DVec3]) {
+        use rayon::prelude::*;
         let Some(law) = &self.membrane_law else { return };
-        for tri in &self.rosettes {
+        let pulls = |tri: &RosetteTriangle| {
             let (strain, dirs, _) = rosette_strain(tri, x);
             let tension = edge_tensions(tri, law.stress(strain));
-            for k in 0..3 {
+            [0, 1, 2].map(|k| tension[k] * dirs[k])
+        };
+        let add = |f: &mut [DVec3], tri: &RosetteTriangle, pull: [DVec3; 3]| {
+            for (k, pull) in pull.into_iter().enumerate() {
                 let (a, b) = edge_vertices(tri, k);
-                let pull = tension[k] * dirs[k];
                 f[a as usize] += pull;
                 f[b as usize] -= pull;
+            }
+        };
+        // Both paths add the same pulls in the same order: the forces do not depend on
+        // the number of threads.
+        if self.rosettes.len() < PARALLEL_TRIANGLES {
+            for tri in &self.rosettes {
+                add(f, tri, pulls(tri));
+            }
+        } else {
+            let all: Vec<[DVec3; 3]> = self.rosettes.par_iter().map(pulls).collect();
+            for (tri, pull) in self.rosettes.iter().zip(all) {
+                add(f, tri, pull);
             }
         }
     }
@@ -481,9 +497,6 @@ impl Model {
     /// −Σ allowance[i] |d_i|².
     pub fn assemble_membrane_stiffness_within(&self, x: &[DVec3], k: &mut BlockCsr, compressed: CompressedEdges) {
         use rayon::prelude::*;
-        /// Below this many triangles the blocks are added as they are computed; above it
-        /// they are computed on all threads and added afterwards.
-        const PARALLEL_TRIANGLES: usize = 4096;
         k.clear();
         let Some(law) = &self.membrane_law else { return };
         // Each vertex's scale for the compressed edges it ends (0: dropped).
@@ -635,16 +648,43 @@ impl Model {
 
 /// ½ Σ Q_ab x_a·x_b, J.
 fn quadratic_energy(q: &ScalarCsr, x: &[DVec3]) -> f64 {
-    0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>()
+    if x.len() < PARALLEL_TRIANGLES {
+        return 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>();
+    }
+    0.5 * sum_of(x.len(), |a| q.entries_of_row(a as u32).map(|(b, v)| v * x[a].dot(x[b as usize])).sum::<f64>())
+}
+
+/// Above this many triangles (or vertices) the per-element loops of forces, energies and
+/// stiffness run on rayon's threads. Below it a loop takes tens of microseconds, about what
+/// handing it to another thread costs.
+const PARALLEL_TRIANGLES: usize = 4096;
+
+/// Σ term(i) for i < count: in order on one thread for small counts; above
+/// `PARALLEL_TRIANGLES`, as partial sums over fixed chunks added in order, so that the
+/// result does not depend on the number of threads.
+fn sum_of(count: usize, term: impl Fn(usize) -> f64 + Sync) -> f64 {
+    use rayon::prelude::*;
+    const CHUNK: usize = 1024;
+    if count < PARALLEL_TRIANGLES {
+        return (0..count).map(term).sum();
+    }
+    let partial: Vec<f64> = (0..count.div_ceil(CHUNK)).into_par_iter().map(|c| (c * CHUNK..((c + 1) * CHUNK).min(count)).map(&term).sum()).collect();
+    partial.iter().sum()
 }
 
 /// f −= Q x for an energy ½ Σ Q_ab x_a·x_b whose rows sum to zero, written as
 /// −Σ_b Q_ab (x_b − x_a): the same force, but independent of where the origin is, so it
 /// keeps its round-off small far from the origin.
 fn subtract_quadratic_force(q: &ScalarCsr, x: &[DVec3], f: &mut [DVec3]) {
-    for (a, fa) in f.iter_mut().enumerate() {
+    use rayon::prelude::*;
+    let row = |(a, fa): (usize, &mut DVec3)| {
         let xa = x[a];
         *fa -= q.entries_of_row(a as u32).map(|(b, v)| v * (x[b as usize] - xa)).sum::<DVec3>();
+    };
+    if f.len() < PARALLEL_TRIANGLES {
+        f.iter_mut().enumerate().for_each(row);
+    } else {
+        f.par_iter_mut().enumerate().for_each(row);
     }
 }
 
