@@ -7,11 +7,12 @@
 //! 20 000). The complete factor of a recent matrix leaves CG only the change since then
 //! and the contact couplings to resolve. Its pattern (in-plane one-ring, bending stencil,
 //! fixed vertices) is the model's for the whole run, so the ordering and symbolic analysis
-//! are done once and each factorisation is numeric only. faer factors; the triangular
-//! solves with its supernodal factor run on two threads (`supernodal`).
+//! are done once and each factorisation is numeric only. faer's symbolic analysis picks
+//! the ordering and the supernodes; the numeric factorisation and the triangular solves
+//! run on two threads (`supernodal`).
 
 use crate::sim::sparse::{SystemMatrix, merge_rows};
-use crate::sim::supernodal::SolvePlan;
+use crate::sim::supernodal::SupernodalPlan;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -25,8 +26,9 @@ use std::sync::Arc;
 /// sequential, 0.60 against 0.50 s in all; at 79 169 triangles 4.67 against 3.7–4.05 s,
 /// and a parallel factorisation with sequential solves 3.7–4.1 s; on 2026-12-01, one
 /// factorisation at 20 463 triangles took 350–370 ms on two threads against 245–260 ms on
-/// one). Its solves are left to `SolvePlan`, which splits the elimination tree instead;
-/// faer solves only the simplicial factors it picks for small matrices.
+/// one). Supernodal factors are left to `SupernodalPlan`, which splits the elimination tree
+/// instead; faer factors and solves only the simplicial factors it picks for small
+/// matrices.
 const PARALLELISM: Par = Par::Seq;
 
 /// Where each stored entry of the lower triangle comes from.
@@ -50,9 +52,11 @@ pub struct DirectPattern {
     row_idx: Vec<u32>,
     sources: Vec<Source>,
     symbolic: SymbolicCholesky<u32>,
-    /// The two-thread triangular solves' plan (None: faer's simplicial factor, solved by
-    /// faer).
-    plan: Option<SolvePlan>,
+    /// The two-thread factorisation's and triangular solves' plan (None: faer's simplicial
+    /// factor, made and solved by faer).
+    plan: Option<SupernodalPlan>,
+    /// Where each stored entry goes in L's supernodal blocks, for `plan`.
+    destinations: Vec<usize>,
     /// The fixed vertices it was built for.
     fixed: Vec<bool>,
 }
@@ -105,8 +109,9 @@ impl DirectPattern {
         let size = 3 * n;
         let pattern = SymbolicSparseColMatRef::new_checked(size, size, &col_ptr, None, &row_idx);
         let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, Default::default(), Default::default()).ok()?;
-        let plan = SolvePlan::new(&symbolic);
-        Some(Self { col_ptr, row_idx, sources, symbolic, plan, fixed: a.fixed.to_vec() })
+        let plan = SupernodalPlan::new(&symbolic);
+        let destinations = plan.as_ref().map_or_else(Vec::new, |p| p.destinations(&col_ptr, &row_idx));
+        Some(Self { col_ptr, row_idx, sources, symbolic, plan, destinations, fixed: a.fixed.to_vec() })
     }
 
     /// Whether this pattern is that of `a` (the same vertices fixed).
@@ -171,6 +176,12 @@ impl DirectFactor {
             &values,
         );
         let mut factor = vec![0.0f32; symbolic.len_val()];
+        let column = symbolic.len_val() as f64 / size.max(1) as f64;
+        let cost_in_iterations = column / 4.0 * FACTOR_SPEED_RATIO;
+        if let Some(plan) = &pattern.plan {
+            let positive = plan.factor(&values, &pattern.destinations, &mut factor);
+            return positive.then(|| Self { pattern: pattern.clone(), values: factor, cost_in_iterations });
+        }
         let par = PARALLELISM;
         let mut buffer = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f32>(par, Default::default()));
         symbolic
@@ -184,8 +195,6 @@ impl DirectFactor {
                 Default::default(),
             )
             .ok()?;
-        let column = symbolic.len_val() as f64 / size.max(1) as f64;
-        let cost_in_iterations = column / 4.0 * FACTOR_SPEED_RATIO;
         Some(Self { pattern, values: factor, cost_in_iterations })
     }
 

@@ -1,15 +1,20 @@
-//! Triangular solves with faer's supernodal Cholesky factor on two threads.
+//! faer's supernodal Cholesky factor, factored and solved with on two threads.
 //!
-//! faer's own solve walks the supernodes one after another. On the fine drapes it is what
-//! the run waits for (a solve with the factor of the 20 463-triangle drape reads its 45 MB
-//! twice, about 9 ms, and a Newton iteration takes several), and faer's rayon mode, which
-//! parallelises the dense work inside each supernode, was slower on these small supernodes
-//! (see `direct::PARALLELISM`). Here the elimination tree is cut instead: two groups of
-//! disjoint subtrees of about equal size are solved at once, one per thread, and the few
-//! supernodes above them (the last separators) after them (forward) or before them
-//! (backward). The kernels are written out, column by column over each supernode's dense
-//! trapezoid, so that both threads run the same code as one thread does: the result is the
-//! same whatever the number of threads.
+//! faer's own numeric factorisation and solves walk the supernodes one after another, and
+//! on the fine drapes they are what a run waits for: at 20 463 triangles one factorisation
+//! takes 0.15–0.25 s and a solve, which reads the factor's 45 MB twice, about 9 ms.
+//! faer's rayon mode parallelises the dense work inside each supernode, and on these small
+//! supernodes it was slower (see `direct::PARALLELISM`). Here the elimination tree is cut
+//! instead: two groups of disjoint subtrees, of about equal size, are worked at once, one
+//! per thread, and the few supernodes above both (the last separators) after them
+//! (factorisation, forward substitution) or before them (back substitution).
+//!
+//! The factorisation is faer's left-looking one, with faer's dense kernels: a supernode
+//! pulls the updates of the supernodes below it, which are in its own subtree, so each
+//! group reads and writes only its own supernodes. The triangular solves' kernels are
+//! written out, column by column over each supernode's dense trapezoid. Both threads run
+//! the same code as one thread does, on the same groups: the results are the same whatever
+//! the number of threads.
 
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 
@@ -27,7 +32,7 @@ struct Supernode {
 
 /// The layout of a supernodal factor and the split of its supernodes between two threads.
 #[derive(Debug)]
-pub struct SolvePlan {
+pub struct SupernodalPlan {
     nodes: Vec<Supernode>,
     /// Every supernode's below-diagonal rows, one after another.
     rows: Vec<u32>,
@@ -43,19 +48,21 @@ pub struct SolvePlan {
     len: usize,
     /// From this many entries of L on, the groups run on two threads.
     parallel_entries: usize,
+    /// The supernode of each column.
+    column_node: Vec<u32>,
+    /// For each supernode, the earlier supernodes whose rows reach into its columns (the
+    /// updates a left-looking factorisation pulls in), ascending.
+    updaters: Vec<Vec<u32>>,
 }
 
 /// The owner of a row in no group.
 const TOP: u8 = 2;
 
-/// The groups may differ by this share of the factor's entries.
-const BALANCE: f64 = 0.04;
-
 /// Below this many entries of L a solve takes about a millisecond or less, and the two
 /// groups run on the calling thread (the same arithmetic, so the same result).
 const PARALLEL_ENTRIES: usize = 1 << 20;
 
-impl SolvePlan {
+impl SupernodalPlan {
     /// The plan for `symbolic`'s factor; None if faer chose a simplicial factor.
     pub fn new(symbolic: &SymbolicCholesky<u32>) -> Option<Self> {
         let SymbolicCholeskyRaw::Supernodal(s) = symbolic.raw() else { return None };
@@ -103,11 +110,14 @@ impl SolvePlan {
             }
         }
         let total: usize = subtree.iter().zip(&parent).filter(|(_, p)| p.is_none()).map(|(w, _)| w).sum();
-        // Split the largest subtree (its root goes on top) until the subtrees can be dealt
-        // to two groups within BALANCE of each other.
+        // Split the largest subtree (its root goes on top), deal the subtrees to the two
+        // groups largest first, and keep the split whose time on two threads, the top's
+        // entries plus the larger group's, is least. A balanced split can cost more than a
+        // slightly unbalanced one with fewer supernodes on top, which run alone.
         let mut candidates = roots;
-        let mut top = Vec::new();
-        let assignment = loop {
+        let mut top_entries = 0;
+        let mut best: Option<(usize, [Vec<u32>; 2])> = None;
+        while !candidates.is_empty() && 2 * top_entries < total {
             candidates.sort_by_key(|&k| std::cmp::Reverse(subtree[k as usize]));
             let mut load = [0usize; 2];
             let mut assignment = [Vec::new(), Vec::new()];
@@ -116,14 +126,15 @@ impl SolvePlan {
                 load[g] += subtree[k as usize];
                 assignment[g].push(k);
             }
-            let balanced = load[0].abs_diff(load[1]) as f64 <= BALANCE * total as f64;
-            if balanced || candidates.is_empty() {
-                break assignment;
+            let time = top_entries + load[0].max(load[1]);
+            if best.as_ref().is_none_or(|(t, _)| time < *t) {
+                best = Some((time, assignment));
             }
             let largest = candidates.remove(0);
-            top.push(largest);
+            top_entries += entries(&nodes[largest as usize]);
             candidates.extend_from_slice(&children[largest as usize]);
-        };
+        }
+        let assignment = best.map_or_else(|| [Vec::new(), Vec::new()], |(_, a)| a);
         let mut owner_of_node = vec![TOP; count];
         for (g, subtree_roots) in assignment.iter().enumerate() {
             let mut stack = subtree_roots.clone();
@@ -134,7 +145,30 @@ impl SolvePlan {
         }
         let members = |g: u8| (0..count as u32).filter(|&k| owner_of_node[k as usize] == g).collect::<Vec<u32>>();
         let owner: Vec<u8> = column_node.iter().map(|&k| owner_of_node[k as usize]).collect();
-        Some(Self { groups: [members(0), members(1)], top: members(TOP), nodes, rows, forward, owner, len: s.len_val(), parallel_entries: PARALLEL_ENTRIES })
+        let mut updaters = vec![Vec::new(); count];
+        for (d, n) in nodes.iter().enumerate() {
+            let pattern = &rows[n.pattern_start as usize..(n.pattern_start + n.pattern_len) as usize];
+            let mut last = u32::MAX;
+            for &r in pattern {
+                let t = column_node[r as usize];
+                if t != last {
+                    updaters[t as usize].push(d as u32);
+                    last = t;
+                }
+            }
+        }
+        Some(Self {
+            groups: [members(0), members(1)],
+            top: members(TOP),
+            nodes,
+            rows,
+            forward,
+            owner,
+            len: s.len_val(),
+            parallel_entries: PARALLEL_ENTRIES,
+            column_node,
+            updaters,
+        })
     }
 
     /// Share of L's entries in the supernodes above the two groups, and the difference
@@ -161,6 +195,135 @@ impl SolvePlan {
         for (&i, &xi) in self.forward.iter().zip(&x) {
             set(i as usize, xi);
         }
+    }
+
+    /// Where each entry of a matrix's lower triangle goes in L: entry k of column c, row
+    /// `row_idx[k]`, of the matrix whose columns start at `col_ptr` (the symmetric
+    /// permutation moves it to row and column `inverse`).
+    pub fn destinations(&self, col_ptr: &[u32], row_idx: &[u32]) -> Vec<usize> {
+        let mut inverse = vec![0u32; self.forward.len()];
+        for (i, &f) in self.forward.iter().enumerate() {
+            inverse[f as usize] = i as u32;
+        }
+        let mut out = Vec::with_capacity(row_idx.len());
+        for c in 0..col_ptr.len() - 1 {
+            for &r in &row_idx[col_ptr[c] as usize..col_ptr[c + 1] as usize] {
+                let (a, b) = (inverse[r as usize], inverse[c]);
+                let (i, j) = (a.max(b), a.min(b));
+                let node = self.column_node[j as usize];
+                let n = self.nodes[node as usize];
+                let rows = (n.size + n.pattern_len) as usize;
+                let position = if i < n.start + n.size {
+                    (i - n.start) as usize
+                } else {
+                    let pattern = &self.rows[n.pattern_start as usize..(n.pattern_start + n.pattern_len) as usize];
+                    n.size as usize + pattern.binary_search(&i).expect("the symbolic factor's pattern holds every entry")
+                };
+                out.push(n.values + (j - n.start) as usize * rows + position);
+            }
+        }
+        out
+    }
+
+    /// Factors the matrix whose lower-triangle entries are `entries`, placed by
+    /// `destinations`, into `l`; false if it is not positive definite. faer's left-looking
+    /// supernodal LLᵀ, but with the two groups' subtrees factored at once: a supernode
+    /// pulls updates from earlier supernodes of its own subtree only, so each group reads
+    /// and writes its own supernodes, and the top ones follow.
+    pub fn factor(&self, entries: &[f32], destinations: &[usize], l: &mut [f32]) -> bool {
+        assert_eq!(l.len(), self.len, "a factor of another pattern");
+        l.fill(0.0);
+        for (&value, &d) in entries.iter().zip(destinations) {
+            l[d] += value;
+        }
+        let shared = SharedFactor(l.as_mut_ptr());
+        let run = |nodes: &[u32]| {
+            let mut scratch = NodeScratch::new(self.column_node.len());
+            // SAFETY: the supernodes of a group write only their own blocks and read only
+            // blocks of the supernodes below them, which are in the same group's subtrees;
+            // the two groups share no supernode, and the top ones run after both.
+            nodes.iter().all(|&k| unsafe { self.factor_node(&shared, k, &mut scratch) })
+        };
+        let [first, second] = &self.groups;
+        let (a, b) = if self.len >= self.parallel_entries && rayon::current_num_threads() > 1 {
+            rayon::join(|| run(first), || run(second))
+        } else {
+            (run(first), run(second))
+        };
+        a && b && run(&self.top)
+    }
+
+    /// Factors supernode k of the factor behind `shared`, whose descendants are done.
+    ///
+    /// # Safety
+    /// No other thread may be writing supernode k or reading or writing any of the
+    /// supernodes it pulls updates from.
+    unsafe fn factor_node(&self, shared: &SharedFactor, k: u32, scratch: &mut NodeScratch) -> bool {
+        use faer::linalg::matmul::triangular::BlockStructure;
+        use faer::reborrow::{Reborrow, ReborrowMut};
+        use faer::{Accum, MatMut, MatRef, Par};
+        let n = self.nodes[k as usize];
+        let (start, size) = (n.start as usize, n.size as usize);
+        let end = start + size;
+        let pattern = &self.rows[n.pattern_start as usize..(n.pattern_start + n.pattern_len) as usize];
+        let rows = size + pattern.len();
+        for (i, &r) in pattern.iter().enumerate() {
+            scratch.local[r as usize] = (size + i) as u32;
+        }
+        // SAFETY: by the caller's promise this block is ours alone.
+        let own = unsafe { std::slice::from_raw_parts_mut(shared.0.add(n.values), rows * size) };
+        let mut ls = MatMut::from_column_major_slice_mut(own, rows, size);
+        for &d in &self.updaters[k as usize] {
+            let m = self.nodes[d as usize];
+            let d_rows = (m.size + m.pattern_len) as usize;
+            // SAFETY: supernode d is finished and nobody writes it.
+            let block = unsafe { std::slice::from_raw_parts(shared.0.add(m.values), d_rows * m.size as usize) };
+            let ld = MatRef::from_column_major_slice(block, d_rows, m.size as usize);
+            let d_pattern = &self.rows[m.pattern_start as usize..(m.pattern_start + m.pattern_len) as usize];
+            let first = d_pattern.partition_point(|&r| (r as usize) < start);
+            let mid = d_pattern[first..].partition_point(|&r| (r as usize) < end);
+            let below = ld.subrows(m.size as usize + first, d_pattern.len() - first);
+            let upper = below.subrows(0, mid);
+            // The update L_below · L_upperᵀ: its top square's lower triangle and the rest.
+            let height = below.nrows();
+            scratch.product.clear();
+            scratch.product.resize(height * mid, 0.0);
+            let mut product = MatMut::from_column_major_slice_mut(&mut scratch.product, height, mid);
+            let (top, rest) = product.rb_mut().split_at_row_mut(mid);
+            faer::linalg::matmul::triangular::matmul(
+                top,
+                BlockStructure::TriangularLower,
+                Accum::Replace,
+                upper,
+                BlockStructure::Rectangular,
+                upper.transpose(),
+                BlockStructure::Rectangular,
+                1.0f32,
+                Par::Seq,
+            );
+            faer::linalg::matmul::matmul(rest, Accum::Replace, below.subrows(mid, height - mid), upper.transpose(), 1.0f32, Par::Seq);
+            let target_row = |i: usize| {
+                let r = d_pattern[first + i] as usize;
+                if i < mid { r - start } else { scratch.local[r] as usize }
+            };
+            let positions: Vec<usize> = (0..height).map(target_row).collect();
+            for j in 0..mid {
+                let column = positions[j];
+                for i in j..height {
+                    ls[(positions[i], column)] -= product[(i, j)];
+                }
+            }
+        }
+        for &r in pattern {
+            scratch.local[r as usize] = u32::MAX;
+        }
+        let (mut top, bottom) = ls.split_at_row_mut(size);
+        let mut stack = faer::dyn_stack::MemBuffer::new(faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f32>(size, Par::Seq, Default::default()));
+        if faer::linalg::cholesky::llt::factor::cholesky_in_place(top.rb_mut(), Default::default(), Par::Seq, faer::dyn_stack::MemStack::new(&mut stack), Default::default()).is_err() {
+            return false;
+        }
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(top.rb(), bottom.transpose_mut(), Par::Seq);
+        true
     }
 
     /// Both groups at once on copies of x; `merge` takes each group's result back.
@@ -209,7 +372,7 @@ impl SolvePlan {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
             #[target_feature(enable = "avx2,fma")]
-            fn wide(plan: &SolvePlan, values: &[f32], nodes: impl Iterator<Item = u32>, x: &mut [f32]) {
+            fn wide(plan: &SupernodalPlan, values: &[f32], nodes: impl Iterator<Item = u32>, x: &mut [f32]) {
                 let mut work = Vec::new();
                 nodes.for_each(|k| plan.lower_node(values, k, x, &mut work));
             }
@@ -225,7 +388,7 @@ impl SolvePlan {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
             #[target_feature(enable = "avx2,fma")]
-            fn wide(plan: &SolvePlan, values: &[f32], nodes: impl Iterator<Item = u32>, x: &mut [f32]) {
+            fn wide(plan: &SupernodalPlan, values: &[f32], nodes: impl Iterator<Item = u32>, x: &mut [f32]) {
                 let mut work = Vec::new();
                 nodes.for_each(|k| plan.upper_node(values, k, x, &mut work));
             }
@@ -283,6 +446,26 @@ impl SolvePlan {
             w[j] = (w[j] - dot(&column[j + 1..], &w[j + 1..])) / column[j];
         }
         x[start..start + size].copy_from_slice(&w[..size]);
+    }
+}
+
+/// L's entries, shared by the threads that factor disjoint groups of its supernodes.
+struct SharedFactor(*mut f32);
+
+// SAFETY: the threads write disjoint supernode blocks (see `SupernodalPlan::factor`).
+unsafe impl Sync for SharedFactor {}
+
+/// A thread's work space while it factors supernodes.
+struct NodeScratch {
+    /// Position of a row among the current supernode's rows (u32::MAX: not among them).
+    local: Vec<u32>,
+    /// One update's product.
+    product: Vec<f32>,
+}
+
+impl NodeScratch {
+    fn new(dimension: usize) -> Self {
+        Self { local: vec![u32::MAX; dimension], product: Vec::new() }
     }
 }
 
@@ -358,14 +541,13 @@ mod tests {
             let mut expected = b.clone();
             let mut buffer = MemBuffer::new(symbolic.solve_in_place_scratch::<f32>(1, Par::Seq));
             LltRef::<'_, u32, f32>::new(&symbolic, &factor).solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(&mut expected, n, 1), Par::Seq, MemStack::new(&mut buffer));
-            let Some(plan) = SolvePlan::new(&symbolic) else {
+            let Some(plan) = SupernodalPlan::new(&symbolic) else {
                 // faer picks a simplicial factor for small or very sparse matrices.
                 assert!(g < 150, "a {n}-unknown grid should get a supernodal factor");
                 continue;
             };
             let (top, imbalance) = plan.split();
-            assert!(imbalance <= BALANCE + 1e-12 || plan.groups[1].is_empty(), "imbalance {imbalance}");
-            assert!(top < 0.5, "top share {top}");
+            assert!(top + imbalance < 0.5, "top share {top}, imbalance {imbalance}: two threads would gain little");
             let mut x = vec![0.0f32; n];
             plan.solve(&factor, |i| b[i], |i, v| x[i] = v);
             let scale = expected.iter().fold(0.0f32, |m, v| m.max(v.abs()));
@@ -390,6 +572,41 @@ mod tests {
         }
     }
 
+    /// The two-group factorisation gives faer's factor, on one thread and on two.
+    #[test]
+    fn two_group_factor_matches_faers_factor() {
+        let g = 150;
+        let n = g * g;
+        let (col_ptr, row_idx, values) = grid(g, 0.01);
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, Default::default(), Default::default()).unwrap();
+        let mut expected = vec![0.0f32; symbolic.len_val()];
+        let mut buffer = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f32>(Par::Seq, Default::default()));
+        symbolic
+            .factorize_numeric_llt::<f32>(&mut expected, SparseColMatRef::new(pattern, &values), Side::Lower, Default::default(), Par::Seq, MemStack::new(&mut buffer), Default::default())
+            .unwrap();
+        let mut plan = SupernodalPlan::new(&symbolic).expect("supernodal");
+        plan.parallel_entries = 0;
+        let destinations = plan.destinations(&col_ptr, &row_idx);
+        let factor_on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let mut l = vec![0.0f32; symbolic.len_val()];
+            assert!(pool.install(|| plan.factor(&values, &destinations, &mut l)), "positive definite");
+            l
+        };
+        let (one, two) = (factor_on(1), factor_on(2));
+        assert_eq!(one, two);
+        let scale = expected.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        for (k, (a, b)) in one.iter().zip(&expected).enumerate() {
+            assert!((a - b).abs() <= 1e-5 * scale, "entry {k}: {a} against faer's {b}");
+        }
+        // An indefinite matrix is refused.
+        let mut indefinite = values.clone();
+        indefinite[col_ptr[n / 2] as usize] = -1.0;
+        let mut l = vec![0.0f32; symbolic.len_val()];
+        assert!(!plan.factor(&indefinite, &destinations, &mut l));
+    }
+
     /// The result does not depend on the number of threads.
     #[test]
     fn same_result_on_one_and_two_threads() {
@@ -403,7 +620,7 @@ mod tests {
         symbolic
             .factorize_numeric_llt::<f32>(&mut factor, SparseColMatRef::new(pattern, &values), Side::Lower, Default::default(), Par::Seq, MemStack::new(&mut buffer), Default::default())
             .unwrap();
-        let mut plan = SolvePlan::new(&symbolic).expect("supernodal");
+        let mut plan = SupernodalPlan::new(&symbolic).expect("supernodal");
         plan.parallel_entries = 0;
         let b: Vec<f32> = (0..n).map(|i| ((i * 31) % 17) as f32 - 8.0).collect();
         let solve_on = |threads: usize| {
