@@ -237,8 +237,9 @@ impl SupernodalPlan {
             l[d] += value;
         }
         let shared = SharedFactor(l.as_mut_ptr());
+        let largest = self.nodes.iter().map(|n| n.size as usize).max().unwrap_or(0);
         let run = |nodes: &[u32]| {
-            let mut scratch = NodeScratch::new(self.column_node.len());
+            let mut scratch = NodeScratch::new(self.column_node.len(), largest);
             // SAFETY: the supernodes of a group write only their own blocks and read only
             // blocks of the supernodes below them, which are in the same group's subtrees;
             // the two groups share no supernode, and the top ones run after both.
@@ -306,7 +307,9 @@ impl SupernodalPlan {
                 let r = d_pattern[first + i] as usize;
                 if i < mid { r - start } else { scratch.local[r] as usize }
             };
-            let positions: Vec<usize> = (0..height).map(target_row).collect();
+            let positions = &mut scratch.positions;
+            positions.clear();
+            positions.extend((0..height).map(target_row));
             for j in 0..mid {
                 let column = positions[j];
                 for i in j..height {
@@ -318,8 +321,8 @@ impl SupernodalPlan {
             scratch.local[r as usize] = u32::MAX;
         }
         let (mut top, bottom) = ls.split_at_row_mut(size);
-        let mut stack = faer::dyn_stack::MemBuffer::new(faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f32>(size, Par::Seq, Default::default()));
-        if faer::linalg::cholesky::llt::factor::cholesky_in_place(top.rb_mut(), Default::default(), Par::Seq, faer::dyn_stack::MemStack::new(&mut stack), Default::default()).is_err() {
+        let stack = faer::dyn_stack::MemStack::new(&mut scratch.stack);
+        if faer::linalg::cholesky::llt::factor::cholesky_in_place(top.rb_mut(), Default::default(), Par::Seq, stack, Default::default()).is_err() {
             return false;
         }
         faer::linalg::triangular_solve::solve_lower_triangular_in_place(top.rb(), bottom.transpose_mut(), Par::Seq);
@@ -459,13 +462,18 @@ unsafe impl Sync for SharedFactor {}
 struct NodeScratch {
     /// Position of a row among the current supernode's rows (u32::MAX: not among them).
     local: Vec<u32>,
-    /// One update's product.
+    /// One update's product, and where its rows go.
     product: Vec<f32>,
+    positions: Vec<usize>,
+    /// faer's work space for the dense factorisation of a diagonal block.
+    stack: faer::dyn_stack::MemBuffer,
 }
 
 impl NodeScratch {
-    fn new(dimension: usize) -> Self {
-        Self { local: vec![u32::MAX; dimension], product: Vec::new() }
+    /// For a factor of `dimension` columns whose largest supernode has `largest`.
+    fn new(dimension: usize, largest: usize) -> Self {
+        let stack = faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f32>(largest, faer::Par::Seq, Default::default());
+        Self { local: vec![u32::MAX; dimension], product: Vec::new(), positions: Vec::new(), stack: faer::dyn_stack::MemBuffer::new(stack) }
     }
 }
 
@@ -523,20 +531,34 @@ mod tests {
         (col_ptr, row_idx, values)
     }
 
+    /// A shifted grid Laplacian, its symbolic factor and faer's numeric factor.
+    struct Factored {
+        col_ptr: Vec<u32>,
+        row_idx: Vec<u32>,
+        values: Vec<f32>,
+        symbolic: SymbolicCholesky<u32>,
+        factor: Vec<f32>,
+    }
+
+    fn factored_grid(g: usize) -> Factored {
+        let n = g * g;
+        let (col_ptr, row_idx, values) = grid(g, 0.01);
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, Default::default(), Default::default()).unwrap();
+        let mut factor = vec![0.0f32; symbolic.len_val()];
+        let mut buffer = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f32>(Par::Seq, Default::default()));
+        symbolic
+            .factorize_numeric_llt::<f32>(&mut factor, SparseColMatRef::new(pattern, &values), Side::Lower, Default::default(), Par::Seq, MemStack::new(&mut buffer), Default::default())
+            .unwrap();
+        Factored { col_ptr, row_idx, values, symbolic, factor }
+    }
+
     /// The solve agrees with faer's on the same factor, and A x reproduces b.
     #[test]
     fn two_group_solve_matches_faers_solve() {
         for g in [3usize, 150, 200] {
             let n = g * g;
-            let (col_ptr, row_idx, values) = grid(g, 0.01);
-            let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-            let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, Default::default(), Default::default()).unwrap();
-            let mut factor = vec![0.0f32; symbolic.len_val()];
-            let mut buffer = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f32>(Par::Seq, Default::default()));
-            let matrix = SparseColMatRef::new(pattern, &values);
-            symbolic
-                .factorize_numeric_llt::<f32>(&mut factor, matrix, Side::Lower, Default::default(), Par::Seq, MemStack::new(&mut buffer), Default::default())
-                .unwrap();
+            let Factored { col_ptr, row_idx, values, symbolic, factor } = factored_grid(g);
             let b: Vec<f32> = (0..n).map(|i| ((i * 7919) % 13) as f32 - 6.0).collect();
             let mut expected = b.clone();
             let mut buffer = MemBuffer::new(symbolic.solve_in_place_scratch::<f32>(1, Par::Seq));
@@ -575,16 +597,8 @@ mod tests {
     /// The two-group factorisation gives faer's factor, on one thread and on two.
     #[test]
     fn two_group_factor_matches_faers_factor() {
-        let g = 150;
-        let n = g * g;
-        let (col_ptr, row_idx, values) = grid(g, 0.01);
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-        let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, Default::default(), Default::default()).unwrap();
-        let mut expected = vec![0.0f32; symbolic.len_val()];
-        let mut buffer = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f32>(Par::Seq, Default::default()));
-        symbolic
-            .factorize_numeric_llt::<f32>(&mut expected, SparseColMatRef::new(pattern, &values), Side::Lower, Default::default(), Par::Seq, MemStack::new(&mut buffer), Default::default())
-            .unwrap();
+        let n = 150 * 150;
+        let Factored { col_ptr, row_idx, values, symbolic, factor: expected } = factored_grid(150);
         let mut plan = SupernodalPlan::new(&symbolic).expect("supernodal");
         plan.parallel_entries = 0;
         let destinations = plan.destinations(&col_ptr, &row_idx);
@@ -610,16 +624,8 @@ mod tests {
     /// The result does not depend on the number of threads.
     #[test]
     fn same_result_on_one_and_two_threads() {
-        let g = 150;
-        let n = g * g;
-        let (col_ptr, row_idx, values) = grid(g, 0.01);
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-        let symbolic = factorize_symbolic_cholesky(pattern, Side::Lower, Default::default(), Default::default()).unwrap();
-        let mut factor = vec![0.0f32; symbolic.len_val()];
-        let mut buffer = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f32>(Par::Seq, Default::default()));
-        symbolic
-            .factorize_numeric_llt::<f32>(&mut factor, SparseColMatRef::new(pattern, &values), Side::Lower, Default::default(), Par::Seq, MemStack::new(&mut buffer), Default::default())
-            .unwrap();
+        let n = 150 * 150;
+        let Factored { symbolic, factor, .. } = factored_grid(150);
         let mut plan = SupernodalPlan::new(&symbolic).expect("supernodal");
         plan.parallel_entries = 0;
         let b: Vec<f32> = (0..n).map(|i| ((i * 31) % 17) as f32 - 8.0).collect();
