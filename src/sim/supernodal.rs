@@ -173,13 +173,15 @@ impl SupernodalPlan {
 
     /// Share of L's entries in the supernodes above the two groups, and the difference
     /// between the groups', of the whole.
-    pub fn split(&self) -> (f64, f64) {
+    #[cfg(test)]
+    fn split(&self) -> (f64, f64) {
         let entries = |list: &[u32]| -> usize { list.iter().map(|&k| self.node_entries(k)).sum() };
         let total = self.len.max(1) as f64;
         let (a, b) = (entries(&self.groups[0]), entries(&self.groups[1]));
         (entries(&self.top) as f64 / total, a.abs_diff(b) as f64 / total)
     }
 
+    #[cfg(test)]
     fn node_entries(&self, k: u32) -> usize {
         let n = &self.nodes[k as usize];
         (n.size as usize + n.pattern_len as usize) * n.size as usize

@@ -34,6 +34,9 @@
 //!   at least the reach apart then, and no two vertices have since closed more than twice
 //!   the largest displacement, so the list serves until displacements and the step's
 //!   motion use up the skin; then it is rebuilt. On a draping cloth it lasts many steps.
+//! - On meshes of 4096 triangles or more the searches, the pair filters and the plane
+//!   checks run in fixed chunks on rayon's threads and collect what they find in order, so
+//!   that contact does the same on any number of threads.
 
 pub mod geometry;
 pub mod props;
