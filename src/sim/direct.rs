@@ -171,10 +171,6 @@ impl DirectFactor {
             .collect();
         let size = 3 * a.fixed.len();
         let symbolic = &pattern.symbolic;
-        let matrix = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(size, size, &pattern.col_ptr, None, &pattern.row_idx),
-            &values,
-        );
         let mut factor = vec![0.0f32; symbolic.len_val()];
         let column = symbolic.len_val() as f64 / size.max(1) as f64;
         let cost_in_iterations = column / 4.0 * FACTOR_SPEED_RATIO;
@@ -182,6 +178,10 @@ impl DirectFactor {
             let positive = plan.factor(&values, &pattern.destinations, &mut factor);
             return positive.then(|| Self { pattern: pattern.clone(), values: factor, cost_in_iterations });
         }
+        let matrix = SparseColMatRef::new(
+            SymbolicSparseColMatRef::new_checked(size, size, &pattern.col_ptr, None, &pattern.row_idx),
+            &values,
+        );
         let par = PARALLELISM;
         let mut buffer = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f32>(par, Default::default()));
         symbolic

@@ -372,7 +372,9 @@ impl SupernodalPlan {
     }
 
     /// Forward substitution through `nodes`, with AVX2 and FMA where the processor has
-    /// them (as faer's kernels do).
+    /// them (as faer's kernels do). `upper_nodes` repeats this dispatch: one generic over
+    /// the per-node step left the step outside the AVX2 function (no ymm instruction in
+    /// its code), so each keeps its own.
     fn lower_nodes(&self, values: &[f32], nodes: impl Iterator<Item = u32>, x: &mut [f32]) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
