@@ -74,17 +74,23 @@ fn cases(quick: bool) -> Vec<Case> {
     // this start (README, Speed).
     let sizes: &[(f64, f64)] =
         if quick { &[(800.0, 0.008), (5000.0, 0.008)] } else { &[(800.0, 0.008), (5000.0, 0.008), (20000.0, 0.008), (80000.0, 0.008)] };
+    // Each size with the complete factor and with multigrid, side by side.
     for &(n, window) in sizes {
-        out.push(case(
-            &format!("cusick-drape ~{} tri, first {window} s", n as u64),
-            "cusick-drape",
-            vec![format!("mesh.edge_length={:.5}", drape_edge_for(n))],
-            Some(window),
-            None,
-        ));
+        for solver in SOLVERS {
+            out.push(case(
+                &format!("cusick-drape ~{} tri, first {window} s, {solver}", n as u64),
+                "cusick-drape",
+                vec![format!("mesh.edge_length={:.5}", drape_edge_for(n)), format!("solver.newton.preconditioner={solver}")],
+                Some(window),
+                None,
+            ));
+        }
     }
     out
 }
+
+/// The global preconditioners the drape sizes are run with (`solver.newton.preconditioner`).
+const SOLVERS: [&str; 2] = ["cholesky", "multigrid"];
 
 /// Runs `case` in a child process with `threads` rayon threads.
 fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
@@ -176,16 +182,28 @@ fn summarise(rows: &[BenchRow]) {
             println!("{}: 1 -> 2 threads, wall-clock speed-up {:.2}x", r.case, r.wall_seconds / two.wall_seconds);
         }
     }
-    let drapes: Vec<&BenchRow> = rows.iter().filter(|r| r.threads == 1 && r.case.contains("first")).collect();
-    if let (Some(small), Some(large)) = (drapes.first(), drapes.last())
-        && large.vertices > small.vertices
-    {
-        let per_vertex = (large.peak_memory_mb - small.peak_memory_mb) * 1e6 / (large.vertices - small.vertices) as f64;
-        println!("memory: {per_vertex:.0} bytes per vertex (peak resident growth from {} to {} vertices)", small.vertices, large.vertices);
-        // Cost ∝ N^p between the smallest and the largest drape: p = 1 is linear growth.
-        let exponent = (large.cpu_seconds_per_simulated_second / small.cpu_seconds_per_simulated_second).ln()
-            / (large.triangles as f64 / small.triangles as f64).ln();
-        println!("cost growth: CPU per simulated second grows as (triangles)^{exponent:.2} from {} to {} triangles", small.triangles, large.triangles);
+    for solver in SOLVERS {
+        let drapes: Vec<&BenchRow> = rows.iter().filter(|r| r.threads == 1 && r.case.contains("first") && r.case.ends_with(solver)).collect();
+        if let (Some(small), Some(large)) = (drapes.first(), drapes.last())
+            && large.vertices > small.vertices
+        {
+            let per_vertex = (large.peak_memory_mb - small.peak_memory_mb) * 1e6 / (large.vertices - small.vertices) as f64;
+            println!("{solver}: memory {per_vertex:.0} bytes per vertex (peak resident growth from {} to {} vertices)", small.vertices, large.vertices);
+            // Cost ∝ N^p between the smallest and the largest drape: p = 1 is linear growth.
+            let exponent = (large.cpu_seconds_per_simulated_second / small.cpu_seconds_per_simulated_second).ln()
+                / (large.triangles as f64 / small.triangles as f64).ln();
+            println!(
+                "{solver}: cost growth, CPU per simulated second grows as (triangles)^{exponent:.2} from {} to {} triangles",
+                small.triangles, large.triangles
+            );
+        }
+    }
+    // Multigrid against the complete factor at each size and thread count (wall time).
+    for r in rows.iter().filter(|r| r.case.ends_with(SOLVERS[1])) {
+        let direct_case = r.case.replace(SOLVERS[1], SOLVERS[0]);
+        if let Some(direct) = rows.iter().find(|o| o.case == direct_case && o.threads == r.threads) {
+            println!("{} tri, {} thread(s): multigrid {:.2}x the speed of the complete factor", r.triangles, r.threads, direct.wall_seconds / r.wall_seconds);
+        }
     }
 }
 

@@ -352,7 +352,7 @@ fn bench_quick_writes_one_row_per_case() {
     }
     // The case name is quoted (it may hold commas); the columns after it are numbers.
     let rows: Vec<Vec<&str>> = lines.map(|l| l[l.rfind("\",").expect("a quoted case") + 2..].split(',').collect()).collect();
-    assert_eq!(rows.len(), 5, "three Table 1 scenes and two drape sizes:\n{csv}");
+    assert_eq!(rows.len(), 7, "three Table 1 scenes and two drape sizes with two solvers each:\n{csv}");
     let column = |row: &Vec<&str>, key: &str| -> f64 {
         let i = header.iter().position(|h| *h == key).unwrap();
         row[i - 1].parse().unwrap_or(f64::NAN)
@@ -363,8 +363,12 @@ fn bench_quick_writes_one_row_per_case() {
         assert!((shares - 1.0).abs() < 1e-9, "shares add to {shares}: {row:?}");
         assert!(column(row, "peak_memory_mb") > 1.0, "{row:?}");
     }
-    // The drapes (the last two rows) are the only cases with contact, and the larger has
-    // more triangles.
+    // The drapes (the last four rows: each size with the complete factor, then with
+    // multigrid) are the only cases with contact; a size's two rows are the same mesh, and
+    // the larger size has more triangles.
     assert!(column(&rows[3], "contact_share") > 0.0 && column(&rows[0], "contact_share") == 0.0);
-    assert!(column(&rows[4], "triangles") > 4.0 * column(&rows[3], "triangles"));
+    assert_eq!(column(&rows[3], "triangles"), column(&rows[4], "triangles"));
+    assert!(column(&rows[5], "triangles") > 4.0 * column(&rows[3], "triangles"));
+    let names: Vec<&str> = csv.lines().skip(1).map(|l| &l[1..l.rfind("\",").unwrap()]).collect();
+    assert!(names[3].ends_with("cholesky") && names[4].ends_with("multigrid"), "{names:?}");
 }

@@ -20,15 +20,11 @@ use faer::{Conj, MatMut, Par, Side};
 use glam::DVec3;
 use std::sync::Arc;
 
-/// faer factors on one thread. Its supernodes on cloth meshes are small, and on this
-/// 2-core machine its rayon mode was slower at every size measured (the first two steps
-/// of the drape, two threads, wall time: at 19 791 triangles solve 0.45 s against 0.36 s
-/// sequential, 0.60 against 0.50 s in all; at 79 169 triangles 4.67 against 3.7–4.05 s,
-/// and a parallel factorisation with sequential solves 3.7–4.1 s; on 2026-12-01, one
-/// factorisation at 20 463 triangles took 350–370 ms on two threads against 245–260 ms on
-/// one). Supernodal factors are left to `SupernodalPlan`, which splits the elimination tree
-/// instead; faer factors and solves only the simplicial factors it picks for small
-/// matrices.
+/// faer factors on one thread. Its supernodes on cloth meshes are small, and on two cores
+/// its rayon mode was slower than its sequential one at every drape size measured, factor
+/// and solves alike (docs/performance-log.md). Supernodal factors are left to
+/// `SupernodalPlan`, which splits the elimination tree instead; faer factors and solves
+/// only the simplicial factors it picks for small matrices.
 const PARALLELISM: Par = Par::Seq;
 
 /// Where each stored entry of the lower triangle comes from.
@@ -121,11 +117,10 @@ impl DirectPattern {
 }
 
 /// A factorisation's multiply-adds work on dense supernodal blocks, a solve's read the
-/// factor once each: timed on the 20 463-triangle drape, a factorisation took 145 ms and a
-/// CG iteration with it 8.8 ms (16 iterations), where the multiply-add count says 90. This
-/// ratio keeps the cost a count (the same choice on every machine) but in the right units;
-/// without it the rent-or-buy rule kept factors five times too long (over the first 0.3 s:
-/// 7751 CG iterations and 169 factorisations, 4082 and 238 at a quarter, 27 % less CPU).
+/// factor once each: timed on the 20 000-triangle drape, a factorisation costs about 16 CG
+/// iterations with it, where the multiply-add count says 90. This ratio keeps the cost a
+/// count (the same choice on every machine) but in the right units; without it the
+/// rent-or-buy rule kept factors five times too long.
 const FACTOR_SPEED_RATIO: f64 = 0.2;
 
 /// The Cholesky factor of one Newton matrix.

@@ -14,6 +14,7 @@
 
 use crate::sim::contact::{ContactModel, ContactStats, StepContacts};
 use crate::sim::model::{CompressedEdges, Model};
+use crate::sim::multigrid::Multigrid;
 use crate::sim::direct::{DirectFactor, DirectPattern};
 use crate::sim::sparse::{BlockCsr, CgReport, Preconditioner, SystemMatrix, pcg};
 use glam::DVec3;
@@ -132,6 +133,18 @@ pub enum PreconditionerChoice {
     /// Sparse Cholesky (faer, with a fill-reducing ordering): more memory and a costlier
     /// build, but CG iterations that stay at a few per Newton iteration at any mesh size.
     Cholesky,
+    /// Smoothed-aggregation multigrid with the rigid modes as coarse spaces (`multigrid`):
+    /// memory and build cost that grow with the mesh, more CG iterations than the complete
+    /// factor.
+    Multigrid,
+}
+
+/// The global preconditioners, solved for with the exact matrix shifted where it is
+/// indefinite (`Integrator::solve_shifted`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum GlobalPreconditioner {
+    Cholesky,
+    Multigrid,
 }
 
 impl PreconditionerChoice {
@@ -142,11 +155,13 @@ impl PreconditionerChoice {
     /// contact), 23 and 97.
     pub const AUTO_CHOLESKY_VERTICES: usize = 3000;
 
-    fn complete_factor(self, vertices: usize) -> bool {
+    /// The global preconditioner for a mesh of `vertices`, or None for the incomplete factor.
+    fn global(self, vertices: usize) -> Option<GlobalPreconditioner> {
         match self {
-            Self::Auto => vertices >= Self::AUTO_CHOLESKY_VERTICES,
-            Self::IncompleteCholesky => false,
-            Self::Cholesky => true,
+            Self::Auto => (vertices >= Self::AUTO_CHOLESKY_VERTICES).then_some(GlobalPreconditioner::Cholesky),
+            Self::IncompleteCholesky => None,
+            Self::Cholesky => Some(GlobalPreconditioner::Cholesky),
+            Self::Multigrid => Some(GlobalPreconditioner::Multigrid),
         }
     }
 }
@@ -557,10 +572,11 @@ impl Integrator {
         self.preconditioner.as_ref().is_none_or(|p| p.size != n || p.excess >= p.preconditioner.cost_in_iterations())
     }
 
-    /// Solves Newton's system on a mesh with a complete factor with the exact matrix H plus
-    /// a shift s·M/h² (s = `self.shift`, a share of the inertia), s as small as keeps it
-    /// positive definite (Levenberg and Marquardt's regularisation, in the mass metric).
-    /// False, with nothing solved, if that takes more than `MAX_SHIFT`.
+    /// Solves Newton's system with a global preconditioner (the complete factor or the
+    /// multigrid hierarchy) and the exact matrix H plus a shift s·M/h² (s = `self.shift`, a
+    /// share of the inertia), s as small as keeps it positive definite (Levenberg and
+    /// Marquardt's regularisation, in the mass metric). False, with nothing solved, if that
+    /// takes more than `MAX_SHIFT`.
     ///
     /// A factor that fails (a pivot not positive) or a CG that meets negative curvature or
     /// returns no descent doubles s (from `MIN_SHIFT`), or sets it to the last shift a
@@ -571,19 +587,19 @@ impl Integrator {
     /// for only an iteration or two. The need returns in jumps, from zero to about 3 within
     /// an iteration on the 20 463-triangle drape, and climbing there by doubling failed 94
     /// of 214 factorisations over its first 0.3 s; starting from the last need, 16 of 139
-    /// (CG iterations 4330 → 3713, CPU −17 %, the same Newton iterations).
+    /// (a sixth fewer CG iterations and less CPU, the same Newton iterations).
     ///
-    /// Fine meshes used to take the bounded matrix of `CompressedEdges::Within` throughout,
+    /// Fine meshes do not take the bounded matrix of `CompressedEdges::Within` throughout,
     /// which scales the compressed edges' term at each vertex to at most 90 % of the
     /// inertia. The bound guards against the shortest waves, where a compressed edge's
     /// softening is largest, and inertia per vertex falls as the edge length squared: on the
-    /// 20 463-triangle drape nearly every free vertex was bounded, most to a fiftieth of its
-    /// softening, so the matrix was wrong in the long waves too and Newton converged
+    /// 20 463-triangle drape nearly every free vertex is bounded, most to a fiftieth of its
+    /// softening, so that matrix is wrong in the long waves too and Newton converges
     /// linearly (steps of a few µm for up to 30 iterations, the gradient not falling). The
     /// exact matrix is positive definite in most of those iterations, and a shift makes it
     /// so in most of the rest. Over the first 0.3 s of that drape: 1110 Newton iterations
     /// with the bound, 781 with shifts of at most 0.4, 566 with at most 6.4.
-    fn solve_shifted(&mut self, exact: &SystemMatrix, direction: &mut [DVec3], solve: &mut Solve) -> bool {
+    fn solve_shifted(&mut self, exact: &SystemMatrix, positions: &[DVec3], direction: &mut [DVec3], solve: &mut Solve) -> bool {
         let n = exact.fixed.len();
         let mut rebuild = false;
         let mut raised = false;
@@ -602,7 +618,7 @@ impl Integrator {
                 true
             };
             if rebuild || self.preconditioner_is_stale(n) {
-                let factor = self.direct_factor(&system);
+                let factor = self.global_factor(&system, positions);
                 solve.report.factorizations += 1;
                 solve.timings.solve += lap(solve.clock);
                 match factor {
@@ -638,9 +654,13 @@ impl Integrator {
         }
     }
 
-    /// The complete factor of `system`, on the model's pattern (made once); None if it is
-    /// not positive definite (or the symbolic analysis failed).
-    fn direct_factor(&mut self, system: &SystemMatrix) -> Option<Preconditioner> {
+    /// The global preconditioner of `system` (the cloth at `positions`): the complete factor
+    /// on the model's pattern (made once) or the multigrid hierarchy; None if it is not
+    /// positive definite (or the symbolic analysis failed).
+    fn global_factor(&mut self, system: &SystemMatrix, positions: &[DVec3]) -> Option<Preconditioner> {
+        if self.newton.preconditioner.global(system.fixed.len()) == Some(GlobalPreconditioner::Multigrid) {
+            return Multigrid::new(system, positions).map(Preconditioner::Multigrid);
+        }
         if self.direct_pattern.as_ref().is_none_or(|p| !p.fits(system)) {
             self.direct_pattern = DirectPattern::new(system).map(Arc::new);
         }
@@ -770,9 +790,9 @@ impl Integrator {
             assemble(&mut stiffness, CompressedEdges::Exact);
             timings.forces += lap(&mut clock);
             let system = SystemMatrix { mass_diagonal: &mass_diagonal, stiffness: &stiffness, bending: bending.as_deref(), fixed: &model.fixed, couplings: &couplings };
-            if self.newton.preconditioner.complete_factor(n) {
+            if self.newton.preconditioner.global(n).is_some() {
                 let mut solve = Solve { rhs: &rhs, cg_tolerance, report: &mut *report, timings: &mut timings, clock: &mut clock };
-                if !bounded_throughout && !self.solve_shifted(&system, &mut direction, &mut solve) {
+                if !bounded_throughout && !self.solve_shifted(&system, y, &mut direction, &mut solve) {
                     // This step's remaining iterations take the bounded matrix, positive
                     // definite, and a factor of it.
                     bounded_throughout = true;
@@ -783,7 +803,7 @@ impl Integrator {
                     timings.forces += lap(&mut clock);
                     let system = SystemMatrix { stiffness: &bounded, ..system };
                     if self.preconditioner_is_stale(n) {
-                        let preconditioner = self.direct_factor(&system).unwrap_or_else(|| system.preconditioner());
+                        let preconditioner = self.global_factor(&system, y).unwrap_or_else(|| system.preconditioner());
                         report.factorizations += 1;
                         self.preconditioner = Some(CachedPreconditioner::new(n, preconditioner));
                         timings.solve += lap(&mut clock);
@@ -869,7 +889,7 @@ impl Integrator {
                 // edge per vertex) is kept if Φ is lower there. On a quadratic Φ with
                 // Newton's direction the parabola's minimum is at 1 and nothing is tried.
                 // At 20 463 triangles, where Newton creeps in steps of a few µm, it fired in
-                // about 40 % of the iterations over the first 0.3 s and cut them 1229 → 1110;
+                // about 40 % of the iterations over the first 0.3 s and saved a tenth of them;
                 // it never fires on the coarse scenes.
                 let curvature = 2.0 * (phi - phi0 - slope);
                 let best = if curvature > 0.0 { -slope / curvature } else { f64::INFINITY };

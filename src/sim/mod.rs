@@ -7,6 +7,7 @@ pub mod integrate;
 pub mod material;
 pub mod mesh;
 pub mod model;
+pub mod multigrid;
 pub mod sparse;
 pub mod supernodal;
 

@@ -1,0 +1,941 @@
+//! Smoothed-aggregation algebraic multigrid (Vaněk, Mandel and Brezina, 1996) for the
+//! Newton matrix, used as the conjugate gradient's preconditioner on large meshes, where a
+//! complete factor's fill grows faster than the mesh.
+//!
+//! Each level groups its nodes into aggregates (a node and its strongly coupled
+//! neighbours); the coarse space of an aggregate spans its near-null modes, the motions
+//! that cost the cloth little energy: three translations and, because a thin sheet bends
+//! far more easily than it stretches, three rotations (the rigid motions of a shell). The
+//! tentative prolongator is the aggregates' orthonormal bases of those modes (a QR per
+//! aggregate, whose R gives the next level its modes); one damped Jacobi sweep smooths it,
+//! and the coarse matrix is the Galerkin product PᵀAP. The coarsest level is factored
+//! densely. A V-cycle smooths with a Chebyshev polynomial in D⁻¹A (the same polynomial
+//! before and after the coarse correction, so the cycle is symmetric, as CG needs).
+//!
+//! Written by hand: no crate we can use does smoothed aggregation with geometric
+//! near-null modes on our block structure; the sparse products are Gustavson's.
+
+use crate::sim::sparse::{SystemMatrix, merge_rows};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Rows per task in the parallel products: below `PARALLEL_ROWS` rows everything runs on
+/// the calling thread.
+const CHUNK_ROWS: usize = 1024;
+const PARALLEL_ROWS: usize = 12_288;
+
+/// Near-null modes per aggregate: three translations, three rotations.
+const MODES: usize = 6;
+
+/// A level of this many unknowns or fewer is factored densely.
+const COARSEST_UNKNOWNS: usize = 360;
+
+/// At most this many levels (the coarsening stalls long before on meshes).
+const MAX_LEVELS: usize = 12;
+
+/// Strength of connection: nodes i and j are coupled strongly when
+/// ‖A_ij‖ ≥ θ √(‖A_ii‖ ‖A_jj‖) (Frobenius norms of the blocks). On the 20 000-triangle
+/// drape θ = 0 (every one-ring neighbour) took a fifth more CG iterations and θ = 0.25
+/// made aggregates too small to coarsen.
+const STRENGTH: f64 = 0.08;
+
+/// Degree of the Chebyshev smoother, and the share of the largest eigenvalue of D⁻¹A
+/// where its interval starts: modes above it are smoothed, those below are left to the
+/// coarse levels. On the 20 000-triangle drape (block Jacobi) degree 3 took a fifth fewer
+/// CG iterations than degree 2 and 5 % less time; a lower end of 0.05 took a quarter fewer
+/// iterations than 0.1.
+const CHEBYSHEV_DEGREE: usize = 3;
+const CHEBYSHEV_LOWER: f64 = 0.05;
+const CHEBYSHEV_UPPER: f64 = 1.1;
+const POWER_ITERATIONS: usize = 12;
+
+/// Scalar compressed sparse rows.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Csr {
+    rows: usize,
+    columns: usize,
+    row_start: Vec<u32>,
+    cols: Vec<u32>,
+    values: Vec<f64>,
+}
+
+impl Csr {
+    fn row(&self, i: usize) -> (&[u32], &[f64]) {
+        let (s, e) = (self.row_start[i] as usize, self.row_start[i + 1] as usize);
+        (&self.cols[s..e], &self.values[s..e])
+    }
+
+    fn entries(&self) -> usize {
+        self.values.len()
+    }
+
+    /// y = A x.
+    fn multiply(&self, x: &[f64], y: &mut [f64]) {
+        let row = |i: usize| {
+            let (c, v) = self.row(i);
+            c.iter().zip(v).map(|(&j, &a)| a * x[j as usize]).sum::<f64>()
+        };
+        if self.rows < PARALLEL_ROWS {
+            y.iter_mut().enumerate().for_each(|(i, out)| *out = row(i));
+        } else {
+            y.par_chunks_mut(CHUNK_ROWS).enumerate().for_each(|(c, chunk)| {
+                for (k, out) in chunk.iter_mut().enumerate() {
+                    *out = row(c * CHUNK_ROWS + k);
+                }
+            });
+        }
+    }
+
+    fn diagonal(&self) -> Vec<f64> {
+        (0..self.rows)
+            .map(|i| {
+                let (c, v) = self.row(i);
+                c.binary_search(&(i as u32)).map_or(0.0, |k| v[k])
+            })
+            .collect()
+    }
+
+    fn transpose(&self) -> Csr {
+        let mut counts = vec![0u32; self.columns + 1];
+        for &c in &self.cols {
+            counts[c as usize + 1] += 1;
+        }
+        for i in 0..self.columns {
+            counts[i + 1] += counts[i];
+        }
+        let row_start = counts.clone();
+        let mut next = counts;
+        let mut cols = vec![0u32; self.entries()];
+        let mut values = vec![0.0; self.entries()];
+        for i in 0..self.rows {
+            let (c, v) = self.row(i);
+            for (&j, &a) in c.iter().zip(v) {
+                let slot = next[j as usize] as usize;
+                next[j as usize] += 1;
+                cols[slot] = i as u32;
+                values[slot] = a;
+            }
+        }
+        Csr { rows: self.columns, columns: self.rows, row_start, cols, values }
+    }
+
+    /// The product A B (Gustavson's row-by-row product with a dense accumulator), and its
+    /// multiply-add count. Rows are computed in fixed chunks, so the result does not
+    /// depend on the thread count.
+    fn product(&self, b: &Csr) -> (Csr, f64) {
+        assert_eq!(self.columns, b.rows, "product of mismatched matrices");
+        let width = b.columns;
+        let chunk_rows = |range: std::ops::Range<usize>, marker: &mut Vec<u32>, sum: &mut Vec<f64>| {
+            let mut lengths = Vec::with_capacity(range.len());
+            let mut cols = Vec::new();
+            let mut values = Vec::new();
+            let mut flops = 0.0;
+            for i in range {
+                let start = cols.len();
+                let (ac, av) = self.row(i);
+                for (&k, &a) in ac.iter().zip(av) {
+                    let (bc, bv) = b.row(k as usize);
+                    flops += bc.len() as f64;
+                    for (&j, &bkj) in bc.iter().zip(bv) {
+                        let j = j as usize;
+                        if marker[j] != i as u32 {
+                            marker[j] = i as u32;
+                            cols.push(j as u32);
+                            sum[j] = a * bkj;
+                        } else {
+                            sum[j] += a * bkj;
+                        }
+                    }
+                }
+                cols[start..].sort_unstable();
+                values.extend(cols[start..].iter().map(|&j| sum[j as usize]));
+                lengths.push((cols.len() - start) as u32);
+            }
+            (lengths, cols, values, flops)
+        };
+        let scratch = || (vec![u32::MAX; width], vec![0.0; width]);
+        let parts: Vec<_> = if self.rows < PARALLEL_ROWS {
+            let (mut marker, mut sum) = scratch();
+            vec![chunk_rows(0..self.rows, &mut marker, &mut sum)]
+        } else {
+            let chunks = self.rows.div_ceil(CHUNK_ROWS);
+            (0..chunks)
+                .into_par_iter()
+                .map_init(scratch, |(marker, sum), c| chunk_rows(c * CHUNK_ROWS..((c + 1) * CHUNK_ROWS).min(self.rows), marker, sum))
+                .collect()
+        };
+        let mut out = Csr { rows: self.rows, columns: width, row_start: Vec::with_capacity(self.rows + 1), ..Csr::default() };
+        out.row_start.push(0);
+        let mut flops = 0.0;
+        for (lengths, cols, values, f) in parts {
+            for l in lengths {
+                let last = *out.row_start.last().expect("starts with 0");
+                out.row_start.push(last + l);
+            }
+            out.cols.extend(cols);
+            out.values.extend(values);
+            flops += f;
+        }
+        (out, flops)
+    }
+}
+
+/// The scalar 3n × 3n matrix of `a` (without its contact couplings, as for the factors):
+/// rows and columns of fixed vertices replaced by the identity. Without `bending`, its
+/// in-plane part and inertia only: the bending matrix lumped into its diagonal, which is
+/// dropping it, as it annihilates translations (its rows sum to zero).
+fn scalar_matrix(a: &SystemMatrix, bending: bool) -> Csr {
+    let n = a.fixed.len();
+    let k = a.stiffness;
+    let mut out = Csr { rows: 3 * n, columns: 3 * n, row_start: vec![0], ..Csr::default() };
+    let mut neighbours = Vec::new();
+    for v in 0..n {
+        if a.fixed[v] {
+            for c in 0..3 {
+                out.cols.push((3 * v + c) as u32);
+                out.values.push(1.0);
+                out.row_start.push(out.cols.len() as u32);
+            }
+            continue;
+        }
+        let q_row = a.bending.filter(|_| bending).map_or((&[][..], 0), |q| q.row_pattern(v));
+        merge_rows(k.row_pattern(v), q_row, |u| !a.fixed[u as usize], &mut neighbours);
+        for row_c in 0..3 {
+            for &(u, block, bending) in &neighbours {
+                for col_c in 0..3 {
+                    // Entry (3v + row_c, 3u + col_c) = A_vu[row_c][col_c].
+                    let mut value = if block == usize::MAX { 0.0 } else { k.values[block].col(col_c)[row_c] };
+                    if row_c == col_c {
+                        if bending != usize::MAX {
+                            value += a.bending.expect("the pattern came from it").values[bending];
+                        }
+                        if u as usize == v {
+                            value += a.mass_diagonal[v];
+                        }
+                    }
+                    out.cols.push(3 * u + col_c as u32);
+                    out.values.push(value);
+                }
+            }
+            out.row_start.push(out.cols.len() as u32);
+        }
+    }
+    out
+}
+
+/// Nodes of a level: node i owns unknowns `start[i]..start[i + 1]`.
+struct Nodes {
+    start: Vec<u32>,
+}
+
+impl Nodes {
+    fn count(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    fn unknowns(&self, i: usize) -> std::ops::Range<usize> {
+        self.start[i] as usize..self.start[i + 1] as usize
+    }
+
+    /// The node of every unknown.
+    fn owners(&self) -> Vec<u32> {
+        let mut owner = vec![0u32; *self.start.last().expect("non-empty") as usize];
+        for i in 0..self.count() {
+            owner[self.unknowns(i)].fill(i as u32);
+        }
+        owner
+    }
+}
+
+/// Groups the nodes into aggregates (Vaněk, Mandel and Brezina's three passes over the
+/// strong-coupling graph): a node whose strong neighbours are all free seeds an aggregate
+/// of itself and them; the rest join the aggregate they are most strongly coupled to, and
+/// any still left (no aggregated strong neighbour) form aggregates with their free
+/// neighbours. `excluded` nodes (fixed vertices) join none. Returns each node's aggregate
+/// (u32::MAX for none) and the aggregate count.
+fn aggregate(a: &Csr, nodes: &Nodes, excluded: &[bool]) -> (Vec<u32>, usize) {
+    let count = nodes.count();
+    let owner = nodes.owners();
+    // Frobenius norms² of the diagonal blocks, then each node's strong neighbours with
+    // their strengths.
+    let mut block_norm = vec![0.0f64; count];
+    let mut strong: Vec<Vec<(u32, f64)>> = vec![Vec::new(); count];
+    let mut sums: Vec<f64> = vec![0.0; count];
+    let mut touched: Vec<u32> = Vec::new();
+    let row_blocks = |i: usize, touched: &mut Vec<u32>, sums: &mut Vec<f64>| {
+        touched.clear();
+        for r in nodes.unknowns(i) {
+            let (c, v) = a.row(r);
+            for (&j, &x) in c.iter().zip(v) {
+                let node = owner[j as usize] as usize;
+                if sums[node] == 0.0 {
+                    touched.push(node as u32);
+                }
+                sums[node] += x * x;
+            }
+        }
+    };
+    for i in 0..count {
+        row_blocks(i, &mut touched, &mut sums);
+        block_norm[i] = sums[i].sqrt();
+        for &j in &touched {
+            sums[j as usize] = 0.0;
+        }
+    }
+    for i in 0..count {
+        if excluded[i] {
+            continue;
+        }
+        row_blocks(i, &mut touched, &mut sums);
+        for &j in &touched {
+            let j = j as usize;
+            let norm = sums[j].sqrt();
+            sums[j] = 0.0;
+            if j != i && !excluded[j] && norm >= STRENGTH * (block_norm[i] * block_norm[j]).sqrt() {
+                strong[i].push((j as u32, norm));
+            }
+        }
+    }
+    const NONE: u32 = u32::MAX;
+    let mut of = vec![NONE; count];
+    let mut aggregates = 0u32;
+    // Pass 1: seeds with every strong neighbour free.
+    for i in 0..count {
+        if excluded[i] || of[i] != NONE || strong[i].iter().any(|&(j, _)| of[j as usize] != NONE) {
+            continue;
+        }
+        of[i] = aggregates;
+        for &(j, _) in &strong[i] {
+            of[j as usize] = aggregates;
+        }
+        aggregates += 1;
+    }
+    // Pass 2: the rest join their most strongly coupled aggregated neighbour's aggregate
+    // (decided on pass 1's aggregates, so the order of the loop does not matter).
+    let first = of.clone();
+    for i in 0..count {
+        if excluded[i] || of[i] != NONE {
+            continue;
+        }
+        let best = strong[i].iter().filter(|&&(j, _)| first[j as usize] != NONE).max_by(|x, y| x.1.total_cmp(&y.1));
+        if let Some(&(j, _)) = best {
+            of[i] = first[j as usize];
+        }
+    }
+    // Pass 3: nodes with no aggregated strong neighbour (or none at all) seed their own.
+    for i in 0..count {
+        if excluded[i] || of[i] != NONE {
+            continue;
+        }
+        of[i] = aggregates;
+        for &(j, _) in &strong[i] {
+            if of[j as usize] == NONE {
+                of[j as usize] = aggregates;
+            }
+        }
+        aggregates += 1;
+    }
+    (of, aggregates as usize)
+}
+
+/// The tentative prolongator: for each aggregate an orthonormal basis (Q of a QR by
+/// Gram–Schmidt, twice for round-off) of its rows of the near-null modes `modes`
+/// (unknowns × MODES, row-major); dependent modes are dropped (an aggregate of one or two
+/// vertices, or of collinear ones, spans fewer than six). Returns P, the coarse nodes
+/// (one per aggregate, as many unknowns as modes kept) and the coarse level's modes (R).
+fn tentative(nodes: &Nodes, of: &[u32], aggregates: usize, modes: &[[f64; MODES]]) -> (Csr, Nodes, Vec<[f64; MODES]>) {
+    let unknowns = modes.len();
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); aggregates];
+    for (i, &g) in of.iter().enumerate() {
+        if g != u32::MAX {
+            members[g as usize].extend(nodes.unknowns(i));
+        }
+    }
+    // Each unknown's row of P: (coarse column, value) pairs.
+    let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); unknowns];
+    let mut coarse_start = vec![0u32];
+    let mut coarse_modes: Vec<[f64; MODES]> = Vec::new();
+    for list in &members {
+        let m = list.len();
+        // Columns of the aggregate's block, Gram–Schmidt in place.
+        let mut q: Vec<[f64; MODES]> = list.iter().map(|&u| modes[u]).collect();
+        let mut r = [[0.0f64; MODES]; MODES];
+        let mut kept: Vec<usize> = Vec::with_capacity(MODES);
+        for col in 0..MODES {
+            let original = (0..m).map(|i| q[i][col] * q[i][col]).sum::<f64>().sqrt();
+            for _ in 0..2 {
+                for &prev in &kept {
+                    let d: f64 = (0..m).map(|i| q[i][prev] * q[i][col]).sum();
+                    r[prev][col] += d;
+                    for row in q.iter_mut() {
+                        row[col] -= d * row[prev];
+                    }
+                }
+            }
+            let norm = (0..m).map(|i| q[i][col] * q[i][col]).sum::<f64>().sqrt();
+            if norm > 1e-8 * original && norm > 0.0 {
+                r[col][col] = norm;
+                for row in q.iter_mut() {
+                    row[col] /= norm;
+                }
+                kept.push(col);
+            }
+        }
+        let base = *coarse_start.last().expect("starts with 0");
+        for (i, &u) in list.iter().enumerate() {
+            for (k, &col) in kept.iter().enumerate() {
+                rows[u].push((base + k as u32, q[i][col]));
+            }
+        }
+        for &col in &kept {
+            let mut row = [0.0; MODES];
+            row.copy_from_slice(&r[col]);
+            coarse_modes.push(row);
+        }
+        coarse_start.push(base + kept.len() as u32);
+    }
+    let columns = *coarse_start.last().expect("starts with 0") as usize;
+    let mut p = Csr { rows: unknowns, columns, row_start: vec![0], ..Csr::default() };
+    for row in rows {
+        for (c, v) in row {
+            p.cols.push(c);
+            p.values.push(v);
+        }
+        p.row_start.push(p.cols.len() as u32);
+    }
+    (p, Nodes { start: coarse_start }, coarse_modes)
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// An estimate of the largest eigenvalue of D⁻¹A by power iteration (from a fixed start,
+/// so that it is the same on every run), with `inverse` applying D⁻¹.
+fn largest_eigenvalue(a: &Csr, inverse: impl Fn(&[f64], &mut [f64])) -> f64 {
+    let n = a.rows;
+    let mut x: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 13) as f64 / 13.0).collect();
+    let (mut ax, mut y) = (vec![0.0; n], vec![0.0; n]);
+    let mut estimate = 0.0;
+    for _ in 0..POWER_ITERATIONS {
+        let norm = dot(&x, &x).sqrt();
+        x.iter_mut().for_each(|v| *v /= norm);
+        a.multiply(&x, &mut ax);
+        inverse(&ax, &mut y);
+        // Rayleigh quotient in the D inner product: xᵀA x / xᵀD x, with D x from D⁻¹A x
+        // and A x (y = D⁻¹A x, so xᵀD y = xᵀA x and yᵀD y = yᵀA x).
+        estimate = dot(&y, &ax) / dot(&x, &ax);
+        std::mem::swap(&mut x, &mut y);
+    }
+    estimate
+}
+
+/// The inverses of a level's diagonal node blocks (3 × 3 on the finest level, one per
+/// vertex; up to 6 × 6 on coarse ones), dense and row-major one after another: the
+/// smoother's D. Scalar Jacobi ignores the coupling of an aggregate's translations and
+/// rotations, which its blocks hold.
+struct BlockDiagonal {
+    nodes: Nodes,
+    /// Where each node's inverse starts in `inverse`.
+    offset: Vec<usize>,
+    inverse: Vec<f64>,
+    /// The unknowns of every node, where all nodes have as many.
+    uniform: Option<usize>,
+}
+
+impl BlockDiagonal {
+    /// None if a block is not positive definite.
+    fn new(a: &Csr, nodes: Nodes) -> Option<Self> {
+        let mut offset = Vec::with_capacity(nodes.count() + 1);
+        let mut inverse = Vec::new();
+        let mut block = Vec::new();
+        for i in 0..nodes.count() {
+            let range = nodes.unknowns(i);
+            let k = range.len();
+            offset.push(inverse.len());
+            block.clear();
+            block.resize(k * k, 0.0);
+            for (row, r) in range.clone().enumerate() {
+                let (c, v) = a.row(r);
+                for (&j, &x) in c.iter().zip(v) {
+                    if range.contains(&(j as usize)) {
+                        block[row * k + (j as usize - range.start)] = x;
+                    }
+                }
+            }
+            if !cholesky(&mut block, k) {
+                return None;
+            }
+            for col in 0..k {
+                let mut e = vec![0.0; k];
+                e[col] = 1.0;
+                cholesky_solve(&block, k, &mut e);
+                inverse.extend_from_slice(&e);
+            }
+        }
+        offset.push(inverse.len());
+        let first = if nodes.count() > 0 { nodes.unknowns(0).len() } else { 0 };
+        let uniform = (0..nodes.count()).all(|i| nodes.unknowns(i).len() == first).then_some(first);
+        Some(Self { nodes, offset, inverse, uniform })
+    }
+
+    /// out = D⁻¹ r (each inverse is symmetric: stored by columns or rows alike).
+    fn apply(&self, r: &[f64], out: &mut [f64]) {
+        let node = |i: usize, out: &mut [f64]| {
+            let range = self.nodes.unknowns(i);
+            let k = range.len();
+            let inv = &self.inverse[self.offset[i]..self.offset[i] + k * k];
+            for a in 0..k {
+                out[a] = (0..k).map(|b| inv[a * k + b] * r[range.start + b]).sum();
+            }
+        };
+        // The finest level's nodes are all vertices of three unknowns: chunks of them run on
+        // rayon's pool when the level is large.
+        if let Some(k) = self.uniform
+            && out.len() >= PARALLEL_ROWS
+        {
+            out.par_chunks_mut(k * CHUNK_ROWS).enumerate().for_each(|(c, chunk)| {
+                for (j, node_out) in chunk.chunks_mut(k).enumerate() {
+                    node(c * CHUNK_ROWS + j, node_out);
+                }
+            });
+            return;
+        }
+        for i in 0..self.nodes.count() {
+            let range = self.nodes.unknowns(i);
+            node(i, &mut out[range]);
+        }
+    }
+}
+
+/// One level of the hierarchy (all but the coarsest).
+struct Level {
+    a: Csr,
+    smoother: BlockDiagonal,
+    /// Largest eigenvalue of D⁻¹A (raised by `CHEBYSHEV_UPPER`).
+    lambda: f64,
+    /// Prolongator from the next level, and its transpose.
+    p: Csr,
+    restriction: Csr,
+}
+
+impl Level {
+    /// x += S(b − A x) with the Chebyshev polynomial S; `x_zero`: x is zero on entry
+    /// (saves the first product).
+    fn smooth(&self, b: &[f64], x: &mut [f64], x_zero: bool, work: &mut [Vec<f64>; 2]) {
+        let [r, d] = work;
+        let n = b.len();
+        if x_zero {
+            r.copy_from_slice(b);
+        } else {
+            self.a.multiply(x, r);
+            for i in 0..n {
+                r[i] = b[i] - r[i];
+            }
+        }
+        let (upper, lower) = (self.lambda, CHEBYSHEV_LOWER * self.lambda);
+        let theta = 0.5 * (upper + lower);
+        let delta = 0.5 * (upper - lower);
+        let sigma = theta / delta;
+        let mut rho = 1.0 / sigma;
+        let mut z = vec![0.0; n];
+        self.smoother.apply(r, &mut z);
+        for i in 0..n {
+            d[i] = z[i] / theta;
+        }
+        let mut ad = vec![0.0; n];
+        for k in 0..CHEBYSHEV_DEGREE {
+            for i in 0..n {
+                x[i] += d[i];
+            }
+            if k + 1 == CHEBYSHEV_DEGREE {
+                break;
+            }
+            self.a.multiply(d, &mut ad);
+            let rho_next = 1.0 / (2.0 * sigma - rho);
+            for i in 0..n {
+                r[i] -= ad[i];
+            }
+            self.smoother.apply(r, &mut z);
+            for i in 0..n {
+                d[i] = rho_next * rho * d[i] + 2.0 * rho_next / delta * z[i];
+            }
+            rho = rho_next;
+        }
+    }
+}
+
+/// The hierarchy: levels from the finest down, and the coarsest matrix's dense Cholesky
+/// factor.
+pub struct Multigrid {
+    levels: Vec<Level>,
+    /// Lower-triangular factor of the coarsest matrix, row-major (size × size).
+    coarse: Vec<f64>,
+    coarse_size: usize,
+    /// Estimated cost of the build in conjugate-gradient iterations with it (see
+    /// `SETUP_SPEED_RATIO`).
+    pub cost_in_iterations: f64,
+    /// Unknowns on each level, finest first (the coarsest last).
+    pub sizes: Vec<usize>,
+}
+
+/// A multiply-add in the sparse products' scattered accumulation and the per-aggregate
+/// work costs more than one in a streamed product: timed on the 20 000-triangle drape, a
+/// build took about 20 CG iterations' time, 3.5 times its count. Kept a count, so that the
+/// rent-or-buy choice is the same on every machine.
+const SETUP_SPEED_RATIO: f64 = 3.5;
+
+impl Multigrid {
+    /// Builds the hierarchy for `a` with the rigid modes of the cloth at `positions`; None
+    /// if the matrix is not positive definite where it shows (a non-positive diagonal, or
+    /// a coarsest matrix that cannot be factored).
+    pub fn new(a: &SystemMatrix, positions: &[DVec3]) -> Option<Self> {
+        let n = a.fixed.len();
+        let fine = scalar_matrix(a, true);
+        // On the finest level, aggregates and the prolongator's smoothing see the in-plane
+        // one-ring only (the filtered matrix of smoothed aggregation): the bending stencil
+        // is two rings wide, and with it the aggregates, the prolongator's rows and the
+        // Galerkin products grow several times over for couplings that are weak next to
+        // the membrane's.
+        let mut filtered = Some(scalar_matrix(a, false));
+        // Translations and rotations about each vertex's own aggregate would be better
+        // conditioned; about the centroid of the cloth they span the same space, and the
+        // QR per aggregate removes the offset.
+        let centre = positions.iter().copied().sum::<DVec3>() / n.max(1) as f64;
+        let mut modes = vec![[0.0; MODES]; 3 * n];
+        for v in 0..n {
+            if a.fixed[v] {
+                continue;
+            }
+            let r = positions[v] - centre;
+            // Rotation ω gives the displacement ω × r.
+            let rotation = [[0.0, r.z, -r.y], [-r.z, 0.0, r.x], [r.y, -r.x, 0.0]];
+            for c in 0..3 {
+                let mut row = [0.0; MODES];
+                row[c] = 1.0;
+                row[3..].copy_from_slice(&rotation[c]);
+                modes[3 * v + c] = row;
+            }
+        }
+        let mut nodes = Nodes { start: (0..=n as u32).map(|v| 3 * v).collect() };
+        let mut excluded: Vec<bool> = a.fixed.to_vec();
+        let mut matrix = fine;
+        let mut levels = Vec::new();
+        let mut setup_flops = 0.0;
+        let mut cycle_flops = 0.0;
+        let mut sizes = Vec::new();
+        while matrix.rows > COARSEST_UNKNOWNS && levels.len() < MAX_LEVELS {
+            let diagonal = matrix.diagonal();
+            if !diagonal.iter().all(|&d| d > 0.0) {
+                return None;
+            }
+            let smoother = BlockDiagonal::new(&matrix, Nodes { start: nodes.start.clone() })?;
+            let lambda = CHEBYSHEV_UPPER * largest_eigenvalue(&matrix, |r, out| smoother.apply(r, out));
+            // The prolongator is smoothed with scalar Jacobi, D the diagonal.
+            let coarsening = filtered.take();
+            let coarsening = coarsening.as_ref().unwrap_or(&matrix);
+            let coarsening_diagonal = coarsening.diagonal();
+            if !coarsening_diagonal.iter().all(|&d| d > 0.0) {
+                return None;
+            }
+            let coarsening_inverse_diagonal: Vec<f64> = coarsening_diagonal.iter().map(|d| 1.0 / d).collect();
+            let scalar_inverse = |r: &[f64], out: &mut [f64]| {
+                for ((o, x), d) in out.iter_mut().zip(r).zip(&coarsening_inverse_diagonal) {
+                    *o = x * d;
+                }
+            };
+            let coarsening_lambda = largest_eigenvalue(coarsening, scalar_inverse);
+            let (of, count) = aggregate(coarsening, &nodes, &excluded);
+            let (tentative, coarse_nodes, coarse_modes) = tentative(&nodes, &of, count, &modes);
+            if tentative.columns == 0 || tentative.columns as f64 > 0.8 * matrix.rows as f64 {
+                break;
+            }
+            // P = (I − ω D⁻¹A) P_t, ω = 4/(3ρ(D⁻¹A)).
+            let (mut p, flops) = coarsening.product(&tentative);
+            setup_flops += flops;
+            let omega = 4.0 / (3.0 * coarsening_lambda);
+            let inverse_diagonal_p = coarsening_inverse_diagonal;
+            for (i, &inverse) in inverse_diagonal_p.iter().enumerate() {
+                let (s, e) = (p.row_start[i] as usize, p.row_start[i + 1] as usize);
+                let (tc, tv) = tentative.row(i);
+                for k in s..e {
+                    let t = tc.iter().position(|&c| c == p.cols[k]).map_or(0.0, |j| tv[j]);
+                    p.values[k] = t - omega * inverse * p.values[k];
+                }
+            }
+            let restriction = p.transpose();
+            let (ap, flops_ap) = matrix.product(&p);
+            let (coarse, flops_c) = restriction.product(&ap);
+            setup_flops += flops_ap + flops_c;
+            cycle_flops += (2 * CHEBYSHEV_DEGREE + 1) as f64 * matrix.entries() as f64 + 2.0 * p.entries() as f64;
+            sizes.push(matrix.rows);
+            levels.push(Level { a: matrix, smoother, lambda, p, restriction });
+            excluded = vec![false; coarse_nodes.count()];
+            nodes = coarse_nodes;
+            modes = coarse_modes;
+            matrix = coarse;
+        }
+        let size = matrix.rows;
+        sizes.push(size);
+        let mut dense = vec![0.0; size * size];
+        for i in 0..size {
+            let (c, v) = matrix.row(i);
+            for (&j, &x) in c.iter().zip(v) {
+                dense[i * size + j as usize] = x;
+            }
+        }
+        // Coarse unknowns whose modes were all dropped have empty rows: identity there.
+        for i in 0..size {
+            if dense[i * size + i] == 0.0 && (0..size).all(|j| dense[i * size + j] == 0.0) {
+                dense[i * size + i] = 1.0;
+            }
+        }
+        let coarse = cholesky(&mut dense, size).then_some(dense)?;
+        setup_flops += (size * size * size) as f64 / 6.0;
+        cycle_flops += 2.0 * (size * size) as f64;
+        let apply_flops = cycle_flops + levels.first().map_or(0.0, |l| l.a.entries() as f64);
+        let cost_in_iterations = SETUP_SPEED_RATIO * setup_flops / apply_flops.max(1.0);
+        let out = Self { levels, coarse, coarse_size: size, cost_in_iterations, sizes };
+        Some(out)
+    }
+
+    /// Total stored entries over all levels' matrices, relative to the finest's (the
+    /// operator complexity).
+    pub fn operator_complexity(&self) -> f64 {
+        let fine = self.levels.first().map_or(1, |l| l.a.entries()) as f64;
+        let coarse = (self.coarse_size * self.coarse_size) as f64 / 2.0;
+        (self.levels.iter().map(|l| l.a.entries() as f64).sum::<f64>() + coarse) / fine
+    }
+
+    /// z ≈ A⁻¹ r by one V-cycle from zero.
+    pub fn solve(&self, r: &[DVec3], z: &mut [DVec3]) {
+        let b: Vec<f64> = r.iter().flat_map(|v| v.to_array()).collect();
+        let mut x = vec![0.0; b.len()];
+        self.cycle(0, &b, &mut x);
+        for (i, out) in z.iter_mut().enumerate() {
+            *out = DVec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+        }
+    }
+
+    fn cycle(&self, level: usize, b: &[f64], x: &mut [f64]) {
+        let Some(this) = self.levels.get(level) else {
+            x.copy_from_slice(b);
+            cholesky_solve(&self.coarse, self.coarse_size, x);
+            return;
+        };
+        let n = b.len();
+        let mut work = [vec![0.0; n], vec![0.0; n]];
+        this.smooth(b, x, true, &mut work);
+        let residual = &mut work[0];
+        this.a.multiply(x, residual);
+        for i in 0..n {
+            residual[i] = b[i] - residual[i];
+        }
+        let mut coarse_b = vec![0.0; this.p.columns];
+        this.restriction.multiply(residual, &mut coarse_b);
+        let mut coarse_x = vec![0.0; this.p.columns];
+        self.cycle(level + 1, &coarse_b, &mut coarse_x);
+        let correction = &mut work[1];
+        this.p.multiply(&coarse_x, correction);
+        for i in 0..n {
+            x[i] += correction[i];
+        }
+        this.smooth(b, x, false, &mut work);
+    }
+}
+
+/// Dense Cholesky in place (row-major, lower triangle); false if a pivot is not positive.
+fn cholesky(a: &mut [f64], n: usize) -> bool {
+    for j in 0..n {
+        let mut d = a[j * n + j];
+        for k in 0..j {
+            d -= a[j * n + k] * a[j * n + k];
+        }
+        // (NaN fails too.)
+        if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * n + j] = d;
+        for i in j + 1..n {
+            let mut s = a[i * n + j];
+            for k in 0..j {
+                s -= a[i * n + k] * a[j * n + k];
+            }
+            a[i * n + j] = s / d;
+        }
+    }
+    true
+}
+
+/// Solves L Lᵀ x = b in place with the factor from `cholesky`.
+fn cholesky_solve(l: &[f64], n: usize, x: &mut [f64]) {
+    for i in 0..n {
+        let s: f64 = (0..i).map(|k| l[i * n + k] * x[k]).sum();
+        x[i] = (x[i] - s) / l[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let s: f64 = (i + 1..n).map(|k| l[k * n + i] * x[k]).sum();
+        x[i] = (x[i] - s) / l[i * n + i];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load_scene;
+    use crate::sim::sparse::{BlockCsr, Preconditioner, ScalarCsr, pcg};
+    use crate::sim::{Fabric, Mesh, Model, Pattern, PhysicsOptions};
+    use glam::DVec2;
+
+    fn dense(a: &Csr) -> Vec<Vec<f64>> {
+        let mut out = vec![vec![0.0; a.columns]; a.rows];
+        for (i, row) in out.iter_mut().enumerate() {
+            let (c, v) = a.row(i);
+            for (&j, &x) in c.iter().zip(v) {
+                row[j as usize] += x;
+            }
+        }
+        out
+    }
+
+    /// A sparse matrix with `rows` × `columns` and a few entries per row, from a formula.
+    fn sample(rows: usize, columns: usize, seed: usize) -> Csr {
+        let mut a = Csr { rows, columns, row_start: vec![0], ..Csr::default() };
+        for i in 0..rows {
+            let mut cols: Vec<u32> = (0..4).map(|k| ((i * 31 + k * 17 + seed * 7) % columns) as u32).collect();
+            cols.sort_unstable();
+            cols.dedup();
+            for &j in &cols {
+                a.cols.push(j);
+                a.values.push(((i + 2 * j as usize + seed) % 11) as f64 - 5.0);
+            }
+            a.row_start.push(a.cols.len() as u32);
+        }
+        a
+    }
+
+    /// The sparse product and transpose agree with dense arithmetic, on one thread and
+    /// in parallel chunks.
+    #[test]
+    fn sparse_product_and_transpose_match_dense_arithmetic() {
+        for rows in [40, PARALLEL_ROWS + 500] {
+            let a = sample(rows, 300, 1);
+            let b = sample(300, 70, 2);
+            let (c, flops) = a.product(&b);
+            assert!(flops > 0.0);
+            let (da, db, dc) = (dense(&a), dense(&b), dense(&c));
+            for i in (0..rows).step_by(37) {
+                for j in 0..70 {
+                    let expected: f64 = (0..300).map(|k| da[i][k] * db[k][j]).sum();
+                    assert!((dc[i][j] - expected).abs() < 1e-9, "({i}, {j}): {} against {expected}", dc[i][j]);
+                }
+            }
+            let t = dense(&a.transpose());
+            for i in (0..rows).step_by(37) {
+                for j in 0..300 {
+                    assert_eq!(t[j][i], da[i][j]);
+                }
+            }
+        }
+    }
+
+    fn wool() -> Fabric {
+        let (config, _) = load_scene("tensile-warp", &[]).expect("bundled preset loads");
+        config.fabric.to_fabric().expect("bundled fabric is valid")
+    }
+
+    /// The Newton matrix at h = 4 ms of a wool sheet `size` m square with edges `edge`,
+    /// pinned along one side and sagging in a smooth, doubly curved shape (membrane and
+    /// bending coupled), stretched 1 % so that every edge is in tension.
+    struct Sheet {
+        model: Model,
+        x: Vec<DVec3>,
+        stiffness: BlockCsr,
+        bending: Option<ScalarCsr>,
+        mass_diagonal: Vec<f64>,
+    }
+
+    fn sheet(size: f64, edge: f64) -> Sheet {
+        let mesh = Mesh::rectangle(size, size, edge, Pattern::Jittered, 3).expect("mesh");
+        let options = PhysicsOptions { membrane: true, bending: true, gravity: DVec3::new(0.0, 0.0, -9.81), damping: 0.0 };
+        let mut model = Model::new(&mesh, &wool(), 0.3, options).expect("model");
+        let shape = |p: DVec2| DVec3::new(1.01 * p.x, 1.01 * p.y, 0.05 * (p.x / size) * (p.x / size) + 0.01 * (3.0 * p.y / size).sin());
+        let x: Vec<DVec3> = model.rest.iter().map(|&p| shape(p)).collect();
+        for (v, &xv) in x.iter().enumerate() {
+            if model.rest[v].x < 1e-9 {
+                model.pin(v as u32, xv);
+            }
+        }
+        let h = 0.004;
+        let mass_diagonal = model.mass.iter().map(|m| m / (h * h)).collect();
+        let mut stiffness = model.stiffness_matrix();
+        model.assemble_membrane_stiffness(&x, &mut stiffness);
+        let bending = model.bending_newton_matrix(&x).map(|q| q.into_owned());
+        Sheet { model, x, stiffness, bending, mass_diagonal }
+    }
+
+    impl Sheet {
+        fn system(&self) -> SystemMatrix<'_> {
+            SystemMatrix { mass_diagonal: &self.mass_diagonal, stiffness: &self.stiffness, bending: self.bending.as_ref(), fixed: &self.model.fixed, couplings: &[] }
+        }
+    }
+
+    /// One V-cycle is a symmetric operator (as the conjugate gradient needs) and positive
+    /// (a descent direction for any residual).
+    #[test]
+    fn cycle_is_symmetric_and_positive() {
+        let s = sheet(0.2, 0.004);
+        let hierarchy = Multigrid::new(&s.system(), &s.x).expect("hierarchy");
+        assert!(hierarchy.sizes.len() >= 3, "levels {:?}", hierarchy.sizes);
+        let n = s.x.len();
+        let field = |k: f64| -> Vec<DVec3> {
+            (0..n)
+                .map(|i| if s.model.fixed[i] { DVec3::ZERO } else { DVec3::new((k * i as f64).sin(), (1.3 * k * i as f64).cos(), 1.0 + (0.1 * i as f64 + k).sin()) })
+                .collect()
+        };
+        let (u, v) = (field(0.37), field(1.91));
+        let (mut mu, mut mv) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+        hierarchy.solve(&u, &mut mu);
+        hierarchy.solve(&v, &mut mv);
+        let dot3 = |a: &[DVec3], b: &[DVec3]| a.iter().zip(b).map(|(p, q)| p.dot(*q)).sum::<f64>();
+        let (vmu, umv) = (dot3(&v, &mu), dot3(&u, &mv));
+        assert!((vmu - umv).abs() < 1e-9 * vmu.abs().max(umv.abs()), "vᵀMu = {vmu}, uᵀMv = {umv}");
+        assert!(dot3(&u, &mu) > 0.0 && dot3(&v, &mv) > 0.0);
+        for (&fixed, m) in s.model.fixed.iter().zip(&mu) {
+            if fixed {
+                assert_eq!(*m, DVec3::ZERO);
+            }
+        }
+    }
+
+    /// The point of multigrid: under refinement (here sixteen times the vertices) the
+    /// conjugate gradient's iterations grow far more slowly than a one-level method's,
+    /// block Jacobi's, which grow with the square root of the condition number (as the
+    /// edge length to the −1 for the membrane, −2 for bending). They do not stay level:
+    /// measured, 23, 40 and 51 iterations against block Jacobi's 370, 950 and 2187 (N^0.29
+    /// against N^0.64): the rigid modes per aggregate do not span a thin sheet's bending
+    /// modes well, which is the known weakness of aggregation on shells.
+    #[test]
+    fn iterations_stay_level_under_refinement() {
+        let mut counts = Vec::new();
+        for edge in [0.005, 0.0025, 0.00125] {
+            let s = sheet(0.1, edge);
+            let a = s.system();
+            let n = s.x.len();
+            let b: Vec<DVec3> = (0..n).map(|i| if s.model.fixed[i] { DVec3::ZERO } else { DVec3::new(0.1, -0.2, 1.0) * s.model.mass[i] }).collect();
+            let hierarchy = Multigrid::new(&a, &s.x).expect("hierarchy");
+            let mut x = vec![DVec3::ZERO; n];
+            let report = pcg(&a, &Preconditioner::Multigrid(hierarchy), &b, &mut x, 1e-8, 2000);
+            assert!(report.relative_residual <= 1e-8, "edge {edge}: residual {} after {} iterations", report.relative_residual, report.iterations);
+            let jacobi = pcg(&a, &Preconditioner::BlockJacobi(a.block_jacobi()), &b, &mut x, 1e-8, 20_000);
+            counts.push((n, report.iterations, jacobi.iterations));
+        }
+        println!("(vertices, multigrid, block Jacobi) CG iterations: {counts:?}");
+        let (coarse, fine) = (counts[0], counts[2]);
+        let growth = |a: usize, b: usize| b as f64 / a as f64;
+        assert!(fine.2 > 3 * coarse.2, "block Jacobi should grow: {counts:?}");
+        assert!(growth(coarse.1, fine.1) < 0.5 * growth(coarse.2, fine.2), "multigrid iterations grow like a one-level method's: {counts:?}");
+        assert!(fine.1 * 10 < fine.2, "multigrid no better than block Jacobi: {counts:?}");
+    }
+}
