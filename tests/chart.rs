@@ -3,7 +3,7 @@
 //! the explicit limit 2/ω_max computed from each model: symplectic Euler diverges above it
 //! and stays bounded below it, while the implicit integrators stay bounded at those steps.
 
-use rosette::chart::{ChartOptions, INACCURATE_ERROR, Plan, Problem, Status};
+use rosette::chart::{ChartOptions, INACCURATE_ERROR, Plan, Problem, Progress, Status};
 use rosette::sim::IntegratorKind;
 use std::path::Path;
 
@@ -28,11 +28,18 @@ fn check_png(path: &Path, width: u32, height: u32) {
 fn quick_chart_writes_its_tables_and_pictures_and_explicit_runs_fail_above_their_limit() {
     let out = std::env::temp_dir().join(format!("rosette-chart-test-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let report = rosette::chart::run(&ChartOptions { out: out.clone(), quick: true, threads: 2 }).unwrap_or_else(|e| panic!("{e}"));
+    // Through the viewer's entry point, which `run` calls with a progress nobody watches.
+    let progress = Progress::default();
+    let report = rosette::chart::run_with_progress(&ChartOptions { out: out.clone(), quick: true, threads: 2 }, &progress)
+        .unwrap_or_else(|e| panic!("{e}"));
     for line in &report.summary {
         println!("{line}");
     }
     let plan = Plan::new(true);
+    // The progress counted every planned run (the quick sweep has no drape reference), and
+    // none is left running.
+    assert_eq!((progress.done(), progress.total()), (plan.accuracy.len() + plan.stability.len(), plan.accuracy.len() + plan.stability.len()));
+    assert!(progress.running().is_empty() && !progress.is_cancelled());
 
     // The CSV files: their headers, and one row per planned run.
     let accuracy = lines(&out.join("accuracy.csv"));

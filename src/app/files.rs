@@ -59,6 +59,7 @@ fn series_columns(key: &str) -> Option<&'static [&'static str]> {
         "lateral_strain" => &["strain", "lateral_strain"],
         "lobe_history" => &["time_s", "lobes"],
         "force_history" => &["time_s", "end_shortening", "end_force_N_per_m", "amplitude_m"],
+        "quasi_static_force" | "dynamic_force" => &["end_shortening", "end_force_N_per_m"],
         _ => return None,
     })
 }

@@ -1,9 +1,12 @@
 //! Live plots of the running test beside their references: the measured stress–strain
-//! curve against the fabric's input curve (paper Fig. 4), the Euler end force against the
-//! elastica, and any scalar measure over time.
+//! curve against the fabric's input curve (paper Fig. 4), the quasi-static Euler end force
+//! against the elastica, and any scalar measure over time (by default one that the test
+//! changes, see [`default_series`]).
 
 use super::worker::Snapshot;
-use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints, Points};
+use crate::scene::SceneKind;
+use egui::Color32;
+use egui_plot::{Corner, HLine, Legend, Line, LineStyle, Plot, PlotBounds, PlotPoints, Points};
 
 /// Scalar measures sampled from the snapshots while the viewer watched.
 #[derive(Debug, Default)]
@@ -19,23 +22,36 @@ pub struct History {
 const HISTORY_LIMIT: usize = 4000;
 
 impl History {
-    /// Adds the snapshot's scalar measures (starting afresh on a new scene or a reset).
+    /// Adds the snapshot's scalar measures (starting afresh on a new scene or a reset). A
+    /// measure that appears during the run (a critical load once the strip buckles, a
+    /// rigidity once the curvature is not zero) joins the list without clearing what was
+    /// recorded; rows without it hold NaN there.
     pub fn record(&mut self, snapshot: &Snapshot) {
         let scalars: Vec<(String, f64)> = snapshot
             .measures
             .as_object()
             .map(|m| m.iter().filter_map(|(k, v)| Some((k.clone(), v.as_f64().filter(|x| x.is_finite())?))).collect())
             .unwrap_or_default();
-        let names: Vec<String> = scalars.iter().map(|(k, _)| k.clone()).collect();
-        if snapshot.scene_generation != self.generation || names != self.names {
+        if snapshot.scene_generation != self.generation {
             self.generation = snapshot.scene_generation;
-            self.names = names;
+            self.names.clear();
             self.rows.clear();
         }
         if self.rows.last().is_some_and(|(t, _)| *t >= snapshot.time) {
             return;
         }
-        self.rows.push((snapshot.time, scalars.into_iter().map(|(_, v)| v).collect()));
+        for (name, _) in &scalars {
+            if !self.names.contains(name) {
+                self.names.push(name.clone());
+                self.rows.iter_mut().for_each(|(_, v)| v.push(f64::NAN));
+            }
+        }
+        let mut values = vec![f64::NAN; self.names.len()];
+        for (name, value) in scalars {
+            let k = self.names.iter().position(|n| *n == name).expect("added above");
+            values[k] = value;
+        }
+        self.rows.push((snapshot.time, values));
         if self.rows.len() > HISTORY_LIMIT {
             let mut keep = false;
             self.rows.retain(|_| {
@@ -45,10 +61,30 @@ impl History {
         }
     }
 
-    /// The series of measure `name` over time.
+    /// The series of measure `name` over time (the samples where it had a value).
     pub fn series(&self, name: &str) -> Vec<[f64; 2]> {
         let Some(k) = self.names.iter().position(|n| n == name) else { return Vec::new() };
-        self.rows.iter().map(|(t, v)| [*t, v[k]]).collect()
+        self.rows.iter().filter(|(_, v)| v[k].is_finite()).map(|(t, v)| [*t, v[k]]).collect()
+    }
+}
+
+/// The measure the "over time" plot opens on for each kind of test: the rig's response,
+/// which changes while the test runs (not a setting such as the compression speed, or a
+/// constant of the fabric such as the bending length).
+pub fn default_series(kind: SceneKind) -> &'static str {
+    match kind {
+        // The clamp force per width rises with the pull.
+        SceneKind::Tensile => "final_stress",
+        // The tip falls under gravity from the horizontal.
+        SceneKind::Cantilever => "tip_drop",
+        // The moment follows the curvature the grip rolls in.
+        SceneKind::Arc => "moment",
+        // The strip bows out once the end force passes the Euler load.
+        SceneKind::EulerBuckling => "midspan_deflection",
+        // The wrinkles grow as the grip shears the sheet.
+        SceneKind::ShearBuckling => "wrinkle_amplitude",
+        // The shadow shrinks as the cloth falls around the pedestal.
+        SceneKind::Drape => "drape_coefficient",
     }
 }
 
@@ -130,27 +166,78 @@ pub fn test_plot(ui: &mut egui::Ui, snapshot: &Snapshot) -> bool {
         }
         return true;
     }
-    if let (Some(history), Some(euler)) = (measures.get("force_history"), measures.get("euler_load").and_then(|v| v.as_f64())) {
-        let points: Vec<[f64; 2]> = history
-            .as_array()
-            .map(|rows| rows.iter().filter_map(|r| Some([r.get(1)?.as_f64()?, r.get(2)?.as_f64()? / euler])).collect())
-            .unwrap_or_default();
-        let top = points.iter().map(|p| p[0]).fold(0.0, f64::max).max(0.01);
+    if let (Some(_), Some(euler)) = (measures.get("force_history"), measures.get("euler_load").and_then(|v| v.as_f64())) {
+        let points = euler_points(measures.get("quasi_static_force"), measures.get("dynamic_force"), euler);
+        // Fixed axes: shortening up to the run's own (the test's target, or further if the
+        // scene ran on), P/P_cr up to EULER_FORCE_TOP, so that the dynamic spikes of a fast
+        // compression (up to 20 P_cr) cannot squash the elastica's 1.0–1.05 into a line.
+        let target = config.test.end_shortening.unwrap_or(0.0);
+        let right = points.dynamic.iter().chain(&points.quasi_static).map(|p| p[0]).fold(target, f64::max).max(0.01) * 1.05;
+        let (off_scale, none_yet) = (points.off_scale, points.quasi_static.is_empty());
         ui.label(format!("End force / Euler load ({euler:.3e} N/m) against end shortening; elastica dashed"));
         Plot::new("euler_live")
             .height(180.0)
-            .legend(Legend::default())
+            .legend(Legend::default().position(Corner::LeftTop))
             .x_axis_label("end shortening Δ/L")
             .y_axis_label("P / P_cr")
+            .allow_zoom(false)
+            .allow_drag(false)
+            .allow_scroll(false)
+            .allow_boxed_zoom(false)
             .show(ui, |plot| {
-                plot.line(Line::new("elastica", PlotPoints::from(elastica(top))).style(LineStyle::dashed_loose()).width(2.0));
+                plot.set_plot_bounds(PlotBounds::from_min_max([0.0, 0.0], [right, EULER_FORCE_TOP]));
+                // The straight strip's branch (P rises to P_cr at a shortening of P_cr over
+                // the membrane stiffness, ~1e-5 here), then the first-mode elastica.
+                let mut reference = vec![[0.0, 0.0]];
+                reference.extend(elastica(right));
+                plot.line(Line::new("elastica", PlotPoints::from(reference)).style(LineStyle::dashed_loose()).width(2.0));
                 plot.hline(HLine::new("Euler load", 1.0).style(LineStyle::dotted_dense()));
-                plot.points(Points::new("measured", PlotPoints::from(points)).radius(2.0));
+                plot.points(Points::new("dynamic", PlotPoints::from(points.dynamic)).color(Color32::from_gray(110)).radius(1.5));
+                plot.points(Points::new("quasi-static", PlotPoints::from(points.quasi_static)).color(Color32::from_rgb(90, 200, 255)).radius(3.0));
             });
-        ui.small("Fast compression runs above the quasi-static elastica until the higher modes settle.");
+        let mut note = format!(
+            "Quasi-static: out-of-balance load on the free vertices under {:.0} % of P_cr·w (the rest drawn grey as dynamic).",
+            100.0 * crate::scene::rigs::QUASI_STATIC_IMBALANCE
+        );
+        if off_scale > 0 {
+            note += &format!(" {off_scale} samples outside 0–{EULER_FORCE_TOP} P_cr are off the scale.");
+        }
+        if none_yet {
+            note += " None yet: a fast compression rings; the hold settles onto the elastica.";
+        }
+        ui.small(note);
         return true;
     }
     false
+}
+
+/// Top of the Euler plot's force axis, P/P_cr: the elastica is at 1.053 at 10 % shortening
+/// and 1.113 at 20 %; this leaves room for the dynamic overshoot around it.
+pub const EULER_FORCE_TOP: f64 = 2.0;
+
+/// The Euler rig's samples as (Δ/L, P/P_cr): quasi-static and dynamic, without those off
+/// the plot's scale (below 0 or above [`EULER_FORCE_TOP`]), which are counted.
+#[derive(Debug, Default, PartialEq)]
+pub struct EulerPoints {
+    pub quasi_static: Vec<[f64; 2]>,
+    pub dynamic: Vec<[f64; 2]>,
+    pub off_scale: usize,
+}
+
+/// Splits the Euler rig's force samples for the plot: `quasi_static` and `dynamic` are its
+/// `quasi_static_force` and `dynamic_force` (rows of Δ/L, P N/m; the rig sorts them by their
+/// out-of-balance load, see [`crate::scene::rigs::QUASI_STATIC_IMBALANCE`]) and `euler` is
+/// P_cr, N/m. Samples off the scale are dropped, not allowed to stretch the axis.
+pub fn euler_points(quasi_static: Option<&serde_json::Value>, dynamic: Option<&serde_json::Value>, euler: f64) -> EulerPoints {
+    let mut points = EulerPoints::default();
+    let mut on_scale = |rows: Option<&serde_json::Value>| -> Vec<[f64; 2]> {
+        let scaled = rows.map(array2).unwrap_or_default().into_iter().map(|[s, p]| [s, p / euler]);
+        let (kept, dropped): (Vec<[f64; 2]>, Vec<[f64; 2]>) = scaled.partition(|p| (0.0..=EULER_FORCE_TOP).contains(&p[1]));
+        points.off_scale += dropped.len();
+        kept
+    };
+    let (quasi_static, dynamic) = (on_scale(quasi_static), on_scale(dynamic));
+    EulerPoints { quasi_static, dynamic, ..points }
 }
 
 /// Plots measure `name` over time.

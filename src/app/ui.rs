@@ -70,6 +70,8 @@ pub struct ViewerUi {
     /// Point of a tensile curve being dragged: (0 warp / 1 weft, point index).
     curve_drag: Option<(usize, usize)>,
     history_choice: String,
+    /// The kind of test `history_choice` was made for.
+    history_kind: Option<crate::scene::SceneKind>,
     mouse_drag: Option<MouseDrag>,
     /// The speed/accuracy chart window (`rosette chart`'s tables).
     pub chart: ChartView,
@@ -92,6 +94,7 @@ impl Default for ViewerUi {
             fabric_sent: None,
             curve_drag: None,
             history_choice: String::new(),
+            history_kind: None,
             mouse_drag: None,
             chart: ChartView::default(),
         }
@@ -381,8 +384,14 @@ impl ViewerUi {
         ui.heading("Live measurements");
         plots::test_plot(ui, snapshot);
         if !self.history.names.is_empty() {
-            if !self.history.names.contains(&self.history_choice) {
-                self.history_choice = self.history.names[0].clone();
+            // Each new test opens on the measure it changes; a choice of the user's stays
+            // while the scene keeps that measure.
+            let kind = snapshot.config.scene.kind;
+            if self.history_kind != Some(kind) || !self.history.names.contains(&self.history_choice) {
+                let default = plots::default_series(kind);
+                self.history_choice =
+                    if self.history.names.iter().any(|n| n == default) { default.to_string() } else { self.history.names[0].clone() };
+                self.history_kind = Some(kind);
             }
             egui::ComboBox::from_id_salt("history").selected_text(format!("over time: {}", self.history_choice)).show_ui(ui, |ui| {
                 for name in &self.history.names {

@@ -19,7 +19,7 @@ use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, channel};
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
-use winit::event_loop::{ActiveEventLoop, EventLoop, EventLoopProxy};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::window::{Window, WindowId};
 
 /// How the viewer starts.
@@ -85,6 +85,7 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
         dialog_rx,
         dialog_open: false,
         screenshot: None,
+        next_repaint: None,
     };
     event_loop.run_app(&mut app).context("the window's event loop failed")?;
     match app.fatal {
@@ -140,6 +141,9 @@ struct App {
     dialog_open: bool,
     /// Where the next frame is to be saved as PNG.
     screenshot: Option<PathBuf>,
+    /// When egui asked for its next frame (an animation, the chart's progress bar), if it
+    /// asked for one later rather than at once.
+    next_repaint: Option<std::time::Instant>,
 }
 
 impl ApplicationHandler<Wake> for App {
@@ -156,6 +160,22 @@ impl ApplicationHandler<Wake> for App {
                 self.fatal = Some(e);
                 event_loop.exit();
             }
+        }
+    }
+
+    /// Sleeps until the frame egui asked for later (`request_repaint_after`), or until the
+    /// next event when it asked for none.
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        match self.next_repaint {
+            Some(due) if due <= std::time::Instant::now() => {
+                self.next_repaint = None;
+                if let Some(gpu) = &self.gpu {
+                    gpu.window.request_redraw();
+                }
+                event_loop.set_control_flow(ControlFlow::Wait);
+            }
+            Some(due) => event_loop.set_control_flow(ControlFlow::WaitUntil(due)),
+            None => event_loop.set_control_flow(ControlFlow::Wait),
         }
     }
 
@@ -270,7 +290,12 @@ impl App {
             gpu.egui_renderer.free_texture(id);
         }
         textures.clear();
-        let repaint_now = output.viewport_output.get(&egui::ViewportId::ROOT).is_some_and(|v| v.repaint_delay.is_zero());
+        let repaint_delay = output.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
+        let repaint_now = repaint_delay.is_some_and(|d| d.is_zero());
+        // A later repaint (egui says Duration::MAX for none) is left to about_to_wait.
+        self.next_repaint = repaint_delay
+            .filter(|d| !d.is_zero() && *d < std::time::Duration::from_secs(3600))
+            .map(|d| std::time::Instant::now() + d);
         self.frames += 1;
         if self.options.quit_after_frames.is_some_and(|n| self.frames >= n) {
             event_loop.exit();

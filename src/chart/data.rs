@@ -179,10 +179,20 @@ pub fn write_stability(path: &Path, rows: &[StabilityRow]) -> Result<(), ChartEr
     write(path, &text)
 }
 
+/// The text of a file, or the error that names it.
+fn read_text(path: &Path) -> Result<String, ChartError> {
+    std::fs::read_to_string(path).map_err(|e| ChartError::Read { path: path.to_path_buf(), message: e.to_string() })
+}
+
 /// The records of a CSV file with the expected header, as fields.
 fn records(path: &Path, header: &str) -> Result<Vec<Vec<String>>, ChartError> {
-    let bad = |message: String| ChartError::Read { path: path.to_path_buf(), message };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
+    records_in(&read_text(path)?, path, header)
+}
+
+/// The records of CSV text with the expected header, as fields; `origin` names the text in
+/// errors.
+fn records_in(text: &str, origin: &Path, header: &str) -> Result<Vec<Vec<String>>, ChartError> {
+    let bad = |message: String| ChartError::Read { path: origin.to_path_buf(), message };
     let mut lines = text.lines();
     if lines.next() != Some(header) {
         return Err(bad(format!("the first line should be the header `{header}`")));
@@ -210,7 +220,13 @@ fn parse_number(text: &str) -> Result<f64, String> {
 }
 
 pub fn read_accuracy(path: &Path) -> Result<Vec<AccuracyRow>, ChartError> {
-    records(path, ACCURACY_HEADER)?
+    parse_accuracy(&read_text(path)?, path)
+}
+
+/// The rows of `accuracy.csv` text (as [`read_accuracy`] reads from a file, e.g. a table
+/// compiled into the binary); `origin` names the text in errors.
+pub fn parse_accuracy(text: &str, origin: &Path) -> Result<Vec<AccuracyRow>, ChartError> {
+    records_in(text, origin, ACCURACY_HEADER)?
         .iter()
         .enumerate()
         .map(|(i, f)| {
@@ -228,13 +244,18 @@ pub fn read_accuracy(path: &Path) -> Result<Vec<AccuracyRow>, ChartError> {
                     pareto: f[9] == "true",
                 })
             };
-            row().map_err(|message| ChartError::Read { path: path.to_path_buf(), message: format!("line {}: {message}", i + 2) })
+            row().map_err(|message| ChartError::Read { path: origin.to_path_buf(), message: format!("line {}: {message}", i + 2) })
         })
         .collect()
 }
 
 pub fn read_stability(path: &Path) -> Result<Vec<StabilityRow>, ChartError> {
-    records(path, STABILITY_HEADER)?
+    parse_stability(&read_text(path)?, path)
+}
+
+/// The rows of `stability.csv` text; `origin` names the text in errors.
+pub fn parse_stability(text: &str, origin: &Path) -> Result<Vec<StabilityRow>, ChartError> {
+    records_in(text, origin, STABILITY_HEADER)?
         .iter()
         .enumerate()
         .map(|(i, f)| {
@@ -255,7 +276,7 @@ pub fn read_stability(path: &Path) -> Result<Vec<StabilityRow>, ChartError> {
                     status: Status::from_name(&f[13]).ok_or(format!("unknown status `{}`", f[13]))?,
                 })
             };
-            row().map_err(|message| ChartError::Read { path: path.to_path_buf(), message: format!("line {}: {message}", i + 2) })
+            row().map_err(|message| ChartError::Read { path: origin.to_path_buf(), message: format!("line {}: {message}", i + 2) })
         })
         .collect()
 }

@@ -130,6 +130,24 @@ pub struct Outcome {
 }
 
 impl Case {
+    /// A short description of the run, e.g. `euler-buckling implicit-euler dt 1.0e-2 s, 10 mm
+    /// edges`, with the stiffness factors when they are not 1.
+    pub fn label(&self) -> String {
+        let step = match self.step {
+            Step::Seconds(dt) => format!("dt {dt:.1e} s"),
+            Step::OfLimit(factor) => format!("dt {factor}x its limit"),
+        };
+        let millimetres = (self.edge_length * 1e4).round() / 10.0;
+        let mut label = format!("{} {} {step}, {millimetres} mm edges", self.problem.name(), self.integrator);
+        if self.tensile_scale != 1.0 {
+            label += &format!(", tensile x{}", self.tensile_scale);
+        }
+        if self.bending_scale != 1.0 {
+            label += &format!(", bending x{}", self.bending_scale);
+        }
+        label
+    }
+
     /// The scene of this case with time step `dt`.
     fn config(&self, dt: f64) -> Result<SceneConfig, String> {
         let mut overrides: Vec<String> = self.problem.overrides().iter().map(|s| s.to_string()).collect();
