@@ -785,10 +785,10 @@ impl StepContacts {
             if c.normal_force > 0.0 {
                 // λF(s) of the slip s = |u_T|: curvature λF'(s)/s across the slip and λF''(s)
                 // along it. Sticking (s ≤ ε), F is quadratic and both are μ_s/ε. Sliding,
-                // F'' < 0 as μ decays to μ_k; 0 is used there. λF'(s)/s along the slip, as
-                // before, was up to μ_s/ε·λ: twenty times a resting vertex's inertia at the
-                // drape's slip threshold, so Newton crept along a sliding vertex's path at
-                // 0.3 µm an iteration.
+                // F'' < 0 as μ decays to μ_k; 0 is used there. λF'(s)/s along the slip would
+                // be up to μ_s/ε·λ: twenty times a resting vertex's inertia at the drape's slip
+                // threshold, and with it Newton creeps along a sliding vertex's path at 0.3 µm
+                // an iteration.
                 let u = y[i] - anchor[i];
                 let t = u - u.dot(c.normal) * c.normal;
                 let slip = t.length();
