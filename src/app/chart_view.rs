@@ -373,7 +373,7 @@ impl ChartView {
                 StabilityMap::Tensile => "dt against tensile stiffness (N/m), tensile pull",
                 StabilityMap::Bending => "dt against bending rigidity (N·m), cantilever",
             });
-            ui.small("green bounded, orange inaccurate, red diverged; ● symplectic Euler, ■ implicit Euler, ▲ BDF2; line: explicit limit 2/ω_max");
+            ui.small("green bounded, orange inaccurate, red diverged; circles symplectic Euler, squares implicit Euler, triangles BDF2; line: explicit limit 2/ω_max");
             Plot::new(("chart_stability", map.name()))
                 .height(200.0)
                 .x_axis_formatter(log_axis)
