@@ -700,7 +700,8 @@ impl Multigrid {
                 dense[i * size + j as usize] = x;
             }
         }
-        // Coarse unknowns whose modes were all dropped have empty rows: identity there.
+        // An unknown with an empty row (a dropped mode makes none, so none is expected)
+        // would make the factor fail: the identity there.
         for i in 0..size {
             if dense[i * size + i] == 0.0 && (0..size).all(|j| dense[i * size + j] == 0.0) {
                 dense[i * size + i] = 1.0;
@@ -711,16 +712,7 @@ impl Multigrid {
         cycle_flops += 2.0 * (size * size) as f64;
         let apply_flops = cycle_flops + levels.first().map_or(0.0, |l| l.a.entries() as f64);
         let cost_in_iterations = SETUP_SPEED_RATIO * setup_flops / apply_flops.max(1.0);
-        let out = Self { levels, coarse, coarse_size: size, cost_in_iterations, sizes };
-        Some(out)
-    }
-
-    /// Total stored entries over all levels' matrices, relative to the finest's (the
-    /// operator complexity).
-    pub fn operator_complexity(&self) -> f64 {
-        let fine = self.levels.first().map_or(1, |l| l.a.entries()) as f64;
-        let coarse = (self.coarse_size * self.coarse_size) as f64 / 2.0;
-        (self.levels.iter().map(|l| l.a.entries() as f64).sum::<f64>() + coarse) / fine
+        Some(Self { levels, coarse, coarse_size: size, cost_in_iterations, sizes })
     }
 
     /// z ≈ A⁻¹ r by one V-cycle from zero.
