@@ -97,6 +97,13 @@ pub struct Euler {
     speed: f64,
 }
 
+impl Euler {
+    /// The Euler load of the pinned strip, π²B_θ/L² (N/m), B_θ across the strip's length.
+    fn euler_load(&self, model: &Model) -> f64 {
+        std::f64::consts::PI.powi(2) * model.bending_stiffness.rigidity_at(-model.warp_angle) / self.length.powi(2)
+    }
+}
+
 pub struct Shear {
     moving: Vec<u32>,
     width: f64,
@@ -250,8 +257,7 @@ impl Rig {
                 // The load left unbalanced on the free vertices, what accelerates them (or is
                 // damped): zero in static equilibrium. See QUASI_STATIC_IMBALANCE.
                 let unbalanced: f64 = f.iter().zip(&model.fixed).filter(|(_, fixed)| !**fixed).map(|(fi, _)| fi.length()).sum();
-                let euler_load = std::f64::consts::PI.powi(2) * model.bending_stiffness.rigidity_at(-model.warp_angle) / r.length.powi(2);
-                let imbalance = unbalanced / (euler_load * r.width);
+                let imbalance = unbalanced / (r.euler_load(model) * r.width);
                 r.history.push((state.time, shortening, force, amplitude, count_half_waves(&z, 0.2), imbalance));
             }
             _ => {}
@@ -322,7 +328,6 @@ impl Rig {
                 })
             }
             Rig::Euler(r) => {
-                let b = model.bending_stiffness.rigidity_at(-model.warp_angle);
                 let critical = r.history.iter().find(|h| h.3 > 0.05 * r.length).map(|h| h.2);
                 let line = r.columns.centre_line(&state.x);
                 let mid = r.columns.nearest(0.5 * r.length);
@@ -341,7 +346,7 @@ impl Rig {
                 json!({
                     "critical_load": critical,
                     "critical_load_definition": "end force when the largest normal deflection first exceeds 5 % of the length",
-                    "euler_load": std::f64::consts::PI.powi(2) * b / r.length.powi(2),
+                    "euler_load": r.euler_load(model),
                     "end_force": last.2,
                     "end_shortening": last.1,
                     "midspan_deflection": line[mid].z.abs(),

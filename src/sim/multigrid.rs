@@ -637,10 +637,8 @@ impl Multigrid {
         let mut cycle_flops = 0.0;
         let mut sizes = Vec::new();
         while matrix.rows > COARSEST_UNKNOWNS && levels.len() < MAX_LEVELS {
-            let diagonal = matrix.diagonal();
-            if !diagonal.iter().all(|&d| d > 0.0) {
-                return None;
-            }
+            // (A block that is not positive definite, a non-positive diagonal entry included,
+            // fails here.)
             let smoother = BlockDiagonal::new(&matrix, Nodes { start: nodes.start.clone() })?;
             let lambda = CHEBYSHEV_UPPER * largest_eigenvalue(&matrix, |r, out| smoother.apply(r, out));
             // The prolongator is smoothed with scalar Jacobi, D the diagonal.
