@@ -40,6 +40,9 @@ pub struct BenchRow {
     pub forces_share: f64,
     pub solve_share: f64,
     pub contact_share: f64,
+    /// The largest wall-clock speed-up any faster linear solver could give this run
+    /// (Amdahl's bound): the reciprocal of the share of step time outside the solve.
+    pub solver_speedup_bound: Option<f64>,
     pub newton_per_step: f64,
     pub cg_per_newton: f64,
     pub peak_memory_mb: f64,
@@ -128,6 +131,7 @@ fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
         forces_share: forces / total,
         solve_share: solve / total,
         contact_share: contact / total,
+        solver_speedup_bound: (forces + contact > 0.0).then(|| total / (forces + contact)),
         newton_per_step: newton / steps.max(1) as f64,
         cg_per_newton: f("cg_iterations") / newton.max(1.0),
         peak_memory_mb: m["peak_memory_bytes"].as_f64().unwrap_or(f64::NAN) / 1e6,
@@ -198,6 +202,20 @@ fn summarise(rows: &[BenchRow]) {
             );
         }
     }
+    // What any linear solver could gain at most (Amdahl's bound): the forces, assembly and
+    // contact of the complete factor's run stay whatever the solver, so a solver that cost
+    // nothing would leave them. The bound is generous: it assumes the same Newton
+    // iterations and counts step time only, not the set-up outside the steps.
+    for r in rows.iter().filter(|r| r.case.ends_with(SOLVERS[0])) {
+        if let Some(bound) = r.solver_speedup_bound {
+            println!(
+                "{} tri, {} thread(s): the linear solve is {:.0} % of the complete factor's step time; no solver can make this run more than {bound:.2}x faster",
+                r.triangles,
+                r.threads,
+                100.0 * r.solve_share
+            );
+        }
+    }
     // Multigrid against the complete factor at each size and thread count (wall time).
     for r in rows.iter().filter(|r| r.case.ends_with(SOLVERS[1])) {
         let direct_case = r.case.replace(SOLVERS[1], SOLVERS[0]);
@@ -212,13 +230,13 @@ fn write_csv(path: &Path, rows: &[BenchRow]) -> Result<()> {
     writeln!(
         f,
         "case,threads,triangles,vertices,steps,simulated_seconds,wall_seconds,cpu_seconds_per_simulated_second,\
-         wall_seconds_per_simulated_second,forces_share,solve_share,contact_share,newton_per_step,cg_per_newton,\
+         wall_seconds_per_simulated_second,forces_share,solve_share,contact_share,solver_speedup_bound,newton_per_step,cg_per_newton,\
          peak_memory_mb,paper_cpu_seconds_per_10ms"
     )?;
     for r in rows {
         writeln!(
             f,
-            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.case,
             r.threads,
             r.triangles,
@@ -231,6 +249,7 @@ fn write_csv(path: &Path, rows: &[BenchRow]) -> Result<()> {
             r.forces_share,
             r.solve_share,
             r.contact_share,
+            r.solver_speedup_bound.map_or(String::new(), |b| b.to_string()),
             r.newton_per_step,
             r.cg_per_newton,
             r.peak_memory_mb,

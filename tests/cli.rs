@@ -362,7 +362,13 @@ fn bench_quick_writes_one_row_per_case() {
         let shares = column(row, "forces_share") + column(row, "solve_share") + column(row, "contact_share");
         assert!((shares - 1.0).abs() < 1e-9, "shares add to {shares}: {row:?}");
         assert!(column(row, "peak_memory_mb") > 1.0, "{row:?}");
+        // Amdahl's bound on any faster solver: the time outside the solve stays.
+        let bound = column(row, "solver_speedup_bound");
+        let outside = column(row, "forces_share") + column(row, "contact_share");
+        assert!(bound >= 1.0 && (bound * outside - 1.0).abs() < 1e-9, "bound {bound} with {outside} of the time outside the solve: {row:?}");
     }
+    let stdout = text(&output.stdout);
+    assert!(stdout.contains("no solver can make this run more than"), "no solver bound printed:\n{stdout}");
     // The drapes (the last four rows: each size with the complete factor, then with
     // multigrid) are the only cases with contact; a size's two rows are the same mesh, and
     // the larger size has more triangles.
