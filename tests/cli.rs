@@ -347,7 +347,7 @@ fn bench_quick_writes_one_row_per_case() {
     let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    for key in ["case", "threads", "triangles", "cpu_seconds_per_simulated_second", "forces_share", "solve_share", "contact_share", "peak_memory_mb"] {
+    for key in ["case", "threads", "triangles", "cpu_seconds_per_simulated_second", "forces_share", "solve_share", "contact_share", "solver_speedup_bound", "peak_memory_mb"] {
         assert!(header.contains(&key), "bench.csv lacks {key}: {header:?}");
     }
     // The case name is quoted (it may hold commas); the columns after it are numbers.
