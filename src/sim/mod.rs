@@ -2,14 +2,11 @@
 //! No rendering, UI or file input/output here.
 pub mod contact;
 pub mod curve;
-pub mod direct;
-pub mod integrate;
+pub mod linalg;
 pub mod material;
 pub mod mesh;
 pub mod model;
-pub mod multigrid;
-pub mod sparse;
-pub mod supernodal;
+pub mod solver;
 
 /// Revision of the model's physics: raised by every change that alters simulated results,
 /// so that results cached from an older model (the chart's drape reference) are recomputed.
@@ -17,7 +14,7 @@ pub mod supernodal;
 pub const MODEL_REVISION: u32 = 2;
 
 pub use curve::PiecewiseLinear;
-pub use integrate::{AdaptiveStep, Integrator, IntegratorKind, NewtonSettings, PreconditionerChoice, State, StepError, StepReport, StepTimings};
+pub use solver::{AdaptiveStep, Integrator, IntegratorKind, NewtonSettings, PreconditionerChoice, State, StepError, StepReport, StepTimings};
 pub use material::{BendingStiffness, Fabric, FabricError, MembraneLaw};
 pub use mesh::{Mesh, MeshError, Pattern};
 pub use model::{Model, ModelError, Motion, PhysicsOptions};

@@ -38,16 +38,29 @@
 //!   checks run in fixed chunks on rayon's threads and collect what they find in order, so
 //!   that contact does the same on any number of threads.
 
+mod cloth;
 pub mod geometry;
 pub mod props;
+mod step;
 
+pub use cloth::{NearPairs, count_self_intersections};
 pub use props::{Prop, PropError, PropShape, SurfacePoint};
 
-use crate::sim::model::Model;
-use crate::sim::sparse::{BlockCsr, Coupling};
-use geometry::{SpatialHash, closest_point_triangle, closest_points_segments, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
-use glam::{DMat3, DVec3};
-use std::sync::Mutex;
+use glam::DVec3;
+
+/// What contact reads of the cloth: its topology and masses.
+#[derive(Debug, Clone, Copy)]
+pub struct Cloth<'a> {
+    pub triangles: &'a [[u32; 3]],
+    /// Undirected edges (a < b).
+    pub edges: &'a [[u32; 2]],
+    /// Vertices whose positions are prescribed.
+    pub fixed: &'a [bool],
+    /// Lumped vertex masses, kg.
+    pub mass: &'a [f64],
+    /// Mean rest edge length, m.
+    pub mean_edge_length: f64,
+}
 
 /// Contact parameters, SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -109,82 +122,6 @@ pub struct ContactModel {
     pub settings: ContactSettings,
     /// World bounding box of each prop (None: unbounded, the ground).
     bounds: Vec<Option<(DVec3, DVec3)>>,
-    /// Cloth–cloth pairs near enough to meet soon, kept from step to step.
-    near: NearPairCache,
-}
-
-/// Cloth–cloth pairs closer than `reach` at positions `origin` (by their bounding boxes).
-#[derive(Debug, Default)]
-struct NearPairs {
-    origin: Vec<DVec3>,
-    reach: f64,
-    /// (vertex, triangle index).
-    vertex_triangle: Vec<(u32, u32)>,
-    /// (edge, edge) indices, first < second, sharing no vertex.
-    edge_edge: Vec<(u32, u32)>,
-}
-
-impl NearPairs {
-    /// Whether every pair that comes within `margin` while its vertices move at most
-    /// `motion` from `start` is listed: in the worst case two vertices have closed by
-    /// twice the largest displacement since the list was built and by twice `motion`.
-    fn covers(&self, start: &[DVec3], motion: f64, margin: f64) -> bool {
-        if self.origin.len() != start.len() {
-            return false;
-        }
-        let moved = start.iter().zip(&self.origin).map(|(a, b)| a.distance_squared(*b)).fold(0.0, f64::max).sqrt();
-        2.0 * moved + 2.0 * motion + margin <= self.reach
-    }
-
-    fn build(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], reach: f64) -> Self {
-        let parallel = triangles.len() >= PARALLEL_TRIANGLES;
-        let cell = mean_edge(x, triangles).max(reach).max(1e-6);
-        let points: Vec<_> = x.iter().map(|&p| (p, p)).collect();
-        let hash = SpatialHash::new(cell, &points);
-        let pad = DVec3::splat(reach);
-        // The hash returns an item once per cell it overlaps (and its bucket-mates): each
-        // query marks what it has taken with its own number instead of searching a list of
-        // them, which took about a quarter of the search's time at 20 000 triangles.
-        let vertex_triangle = search_in_chunks(triangles.len(), x.len(), parallel, |t, taken, found| {
-            let tri = triangles[t];
-            let c = tri.map(|i| x[i as usize]);
-            let (lo, hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
-            hash.query_box(lo - pad, hi + pad, |v| {
-                if taken[v as usize] != t as u32 && !tri.contains(&v) && boxes_overlap((x[v as usize], x[v as usize]), (lo, hi), reach) {
-                    taken[v as usize] = t as u32;
-                    found.push((v, t as u32));
-                }
-            });
-        });
-        let segment = |e: usize| {
-            let [a, b] = edges[e].map(|i| x[i as usize]);
-            (a.min(b), a.max(b))
-        };
-        let boxes: Vec<_> = (0..edges.len()).map(segment).collect();
-        let hash = SpatialHash::new(cell, &boxes);
-        let edge_edge = search_in_chunks(edges.len(), edges.len(), parallel, |e, taken, found| {
-            let [a, b] = edges[e];
-            hash.query_box(boxes[e].0 - pad, boxes[e].1 + pad, |f| {
-                let [c, d] = edges[f as usize];
-                if (f as usize) > e && taken[f as usize] != e as u32 && c != a && c != b && d != a && d != b && boxes_overlap(boxes[e], boxes[f as usize], reach) {
-                    taken[f as usize] = e as u32;
-                    found.push((e as u32, f));
-                }
-            });
-        });
-        Self { origin: x.to_vec(), reach, vertex_triangle, edge_edge }
-    }
-}
-
-/// The near-pair list behind a lock, so that the contact model's searches can renew it
-/// through a shared reference; a clone starts without one.
-#[derive(Debug, Default)]
-struct NearPairCache(Mutex<NearPairs>);
-
-impl Clone for NearPairCache {
-    fn clone(&self) -> Self {
-        Self::default()
-    }
 }
 
 /// A vertex held outside a prop by a plane over one step.
@@ -247,21 +184,9 @@ impl ContactModel {
                 Some((lo, hi))
             })
             .collect();
-        Ok(Self { props, settings, bounds, near: NearPairCache::default() })
+        Ok(Self { props, settings, bounds })
     }
 
-    /// The near-pair list for a search from `start` over paths of at most `motion` for
-    /// pairs that come within `margin`, renewed if it does not cover them.
-    fn near_pairs(&self, model: &Model, start: &[DVec3], motion: f64, margin: f64) -> std::sync::MutexGuard<'_, NearPairs> {
-        // The skin: half an edge lets a draping cloth keep its list for many steps while
-        // adding few pairs beyond those in reach.
-        let skin = 0.5 * model.mean_edge_length;
-        let mut near = self.near.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        if !near.covers(start, motion, margin) {
-            *near = NearPairs::build(start, &model.triangles, &model.edges, margin + 2.0 * motion + skin);
-        }
-        near
-    }
 
     fn near_bounds(&self, prop: usize, a: DVec3, b: DVec3, margin: f64) -> bool {
         match self.bounds[prop] {
@@ -273,11 +198,13 @@ impl ContactModel {
         }
     }
 
+
     /// The contacts for a step from `start` (positions x_n) towards `predicted` (x_n + h v_n
     /// or the BDF2 equivalent), with time step `h` and vertex masses.
-    pub fn begin_step(&self, model: &Model, start: &[DVec3], predicted: &[DVec3], h: f64) -> StepContacts {
-        let (fixed, mass) = (&model.fixed, &model.mass);
-        let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
+    /// The near-pair list `near` is renewed where it no longer covers the step.
+    pub fn begin_step(&self, cloth: Cloth, near: &mut NearPairs, start: &[DVec3], predicted: &[DVec3], h: f64) -> StepContacts {
+        let (fixed, mass) = (cloth.fixed, cloth.mass);
+        let parallel = cloth.triangles.len() >= PARALLEL_TRIANGLES;
         let s = &self.settings;
         let mut contacts = StepContacts {
             planes: Vec::new(),
@@ -297,10 +224,11 @@ impl ContactModel {
         });
         contacts.planes = per_vertex.into_iter().flatten().collect();
         if s.self_collision {
-            contacts.pairs = self.self_pairs(model, start, predicted, h);
+            contacts.pairs = self.self_pairs(cloth, near, start, predicted, h);
         }
         contacts
     }
+
 
     /// Adds vertex `v`'s planes: props within reach of its path, or entered by it. With
     /// `only_missing`, only props the vertex has no plane with yet. Returns how many.
@@ -333,11 +261,12 @@ impl ContactModel {
         added
     }
 
+
     /// After a solve from `start` to `end`: adds planes for paths that enter a prop without
     /// one. Returns how many were added (zero: the step stands).
-    pub fn add_missed(&self, contacts: &mut StepContacts, model: &Model, start: &[DVec3], end: &[DVec3], h: f64) -> usize {
-        let (fixed, mass) = (&model.fixed, &model.mass);
-        let parallel = model.triangles.len() >= PARALLEL_TRIANGLES;
+    pub fn add_missed(&self, contacts: &mut StepContacts, cloth: Cloth, start: &[DVec3], end: &[DVec3], h: f64) -> usize {
+        let (fixed, mass) = (cloth.fixed, cloth.mass);
+        let parallel = cloth.triangles.len() >= PARALLEL_TRIANGLES;
         let props = self.props.len();
         // Which (vertex, prop) have a plane: looked up, not searched for in the list.
         let mut has_plane = vec![false; start.len() * props];
@@ -361,6 +290,7 @@ impl ContactModel {
         added
     }
 
+
     /// Deepest penetration of any vertex into any prop, m (zero when all are outside).
     pub fn penetration(&self, x: &[DVec3], fixed: &[bool]) -> f64 {
         let mut deepest = 0.0f64;
@@ -376,6 +306,7 @@ impl ContactModel {
         }
         deepest
     }
+
 
     /// Velocity-level contact for explicit integrators: positions `x` and velocities `v`
     /// after an unconstrained update from `start`.
@@ -417,113 +348,6 @@ impl ContactModel {
             }
         }
     }
-
-    /// Vertex–triangle and edge–edge pairs within reach over the step.
-    fn self_pairs(&self, model: &Model, start: &[DVec3], predicted: &[DVec3], h: f64) -> Vec<SelfPair> {
-        let (fixed, mass, triangles, edges) = (&model.fixed, &model.mass, &model.triangles, &model.edges);
-        let parallel = triangles.len() >= PARALLEL_TRIANGLES;
-        let delta = self.settings.self_thickness;
-        let motion: Vec<f64> = start.iter().zip(predicted).map(|(a, b)| a.distance(*b)).collect();
-        let near = self.near_pairs(model, start, motion.iter().copied().fold(0.0, f64::max), delta);
-        let stiffness = |m: f64| self.settings.stiffness * m / (h * h);
-        let mut pairs = filter_in_order(&near.vertex_triangle, parallel, |_, &(v, t)| {
-            let (vi, tri) = (v as usize, triangles[t as usize]);
-            let corners = tri.map(|i| i as usize);
-            if fixed[vi] && corners.iter().all(|&i| fixed[i]) {
-                return None;
-            }
-            let reach = delta + motion[vi] + corners.iter().map(|&i| motion[i]).fold(0.0, f64::max);
-            // The triangle's box at the start: a vertex farther from it than the reach is
-            // farther from the triangle too.
-            let c = corners.map(|i| start[i]);
-            if !boxes_overlap((start[vi], start[vi]), (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2])), reach) {
-                return None;
-            }
-            let (q, _) = closest_point_triangle(start[vi], c[0], c[1], c[2]);
-            ((q - start[vi]).length() < reach).then(|| {
-                let m = 0.25 * (mass[vi] + corners.iter().map(|&i| mass[i]).sum::<f64>());
-                SelfPair { vertices: [v, tri[0], tri[1], tri[2]], edge_edge: false, stiffness: stiffness(m) }
-            })
-        });
-        // Edges can pass through each other with every vertex far from every triangle.
-        pairs.extend(filter_in_order(&near.edge_edge, parallel, |_, &(e, f)| {
-            let [a, b] = edges[e as usize].map(|i| i as usize);
-            let [c, d] = edges[f as usize].map(|i| i as usize);
-            if fixed[a] && fixed[b] && fixed[c] && fixed[d] {
-                return None;
-            }
-            let reach = delta + motion[a].max(motion[b]) + motion[c].max(motion[d]);
-            let segment_box = |p: usize, q: usize| (start[p].min(start[q]), start[p].max(start[q]));
-            if !boxes_overlap(segment_box(a, b), segment_box(c, d), reach) {
-                return None;
-            }
-            let (sa, tb) = closest_points_segments(start[a], start[b], start[c], start[d]);
-            let gap = (start[a].lerp(start[b], sa) - start[c].lerp(start[d], tb)).length();
-            (gap < reach).then(|| {
-                let m = 0.25 * (mass[a] + mass[b] + mass[c] + mass[d]);
-                SelfPair { vertices: [a as u32, b as u32, c as u32, d as u32], edge_edge: true, stiffness: stiffness(m) }
-            })
-        }));
-        pairs
-    }
-
-    /// The continuous-collision fail-safe: finds vertex–triangle and edge–edge pairs that
-    /// cross between `start` and `end`, holds their vertices at `start` and gives each
-    /// impact zone its mean velocity. Returns the number of crossings stopped.
-    pub fn stop_self_crossings(&self, model: &Model, start: &[DVec3], end: &mut [DVec3], v: &mut [DVec3]) -> u64 {
-        let (mass, triangles, edges) = (&model.mass, &model.triangles, &model.edges);
-        let n = start.len();
-        let eps = 1e-3 * self.settings.self_thickness;
-        let mut zone: Vec<u32> = (0..n as u32).collect();
-        fn root(zone: &mut [u32], mut i: u32) -> u32 {
-            while zone[i as usize] != i {
-                zone[i as usize] = zone[zone[i as usize] as usize];
-                i = zone[i as usize];
-            }
-            i
-        }
-        let mut stopped = 0u64;
-        let mut frozen = vec![false; n];
-        for _round in 0..50 {
-            let motion = start.iter().zip(end.iter()).map(|(a, b)| a.distance_squared(*b)).fold(0.0, f64::max).sqrt();
-            let crossings = find_crossings(start, end, triangles, edges, &self.near_pairs(model, start, motion, eps), eps);
-            if crossings.is_empty() {
-                break;
-            }
-            stopped += crossings.len() as u64;
-            for group in crossings {
-                let r0 = root(&mut zone, group[0]);
-                for &i in &group {
-                    let r = root(&mut zone, i);
-                    zone[r as usize] = r0;
-                    frozen[i as usize] = true;
-                }
-            }
-            for i in 0..n {
-                if frozen[i] {
-                    end[i] = start[i];
-                }
-            }
-        }
-        if stopped > 0 {
-            // Each zone moves on with its mass-weighted mean velocity (momentum kept).
-            let mut sums: std::collections::HashMap<u32, (DVec3, f64)> = std::collections::HashMap::new();
-            for i in 0..n {
-                if frozen[i] {
-                    let e = sums.entry(root(&mut zone, i as u32)).or_insert((DVec3::ZERO, 0.0));
-                    e.0 += mass[i] * v[i];
-                    e.1 += mass[i];
-                }
-            }
-            for i in 0..n {
-                if frozen[i] {
-                    let (p, m) = sums[&root(&mut zone, i as u32)];
-                    v[i] = p / m;
-                }
-            }
-        }
-        stopped
-    }
 }
 
 /// On meshes of at least this many triangles the searches run on rayon's threads. On
@@ -531,39 +355,6 @@ impl ContactModel {
 /// paper's drape, 875 triangles, the pair filters on rayon's threads took half again as
 /// long as on one).
 const PARALLEL_TRIANGLES: usize = 4096;
-
-/// Runs `search(i, marks, found)` for every i < `count` and returns what it found, in the
-/// order of i whatever the number of threads (if `parallel`, fixed chunks on rayon's
-/// threads). `marks` holds `marks_len` entries, u32::MAX at first, for the search
-/// to mark what item i has taken with i: each thread keeps one array for its chunks, which
-/// is sound because no two items share a number.
-fn search_in_chunks<T: Send>(count: usize, marks_len: usize, parallel: bool, search: impl Fn(usize, &mut [u32], &mut Vec<T>) + Sync) -> Vec<T> {
-    use rayon::prelude::*;
-    const CHUNK: usize = 1024;
-    let run = |first: usize, marks: &mut [u32], found: &mut Vec<T>| {
-        let end = if parallel { (first + CHUNK).min(count) } else { count };
-        for i in first..end {
-            search(i, marks, found);
-        }
-    };
-    if !parallel {
-        let (mut marks, mut found) = (vec![u32::MAX; marks_len], Vec::new());
-        run(0, &mut marks, &mut found);
-        return found;
-    }
-    let parts: Vec<Vec<T>> = (0..count.div_ceil(CHUNK))
-        .into_par_iter()
-        .map_init(
-            || vec![u32::MAX; marks_len],
-            |marks, c| {
-                let mut found = Vec::new();
-                run(c * CHUNK, marks, &mut found);
-                found
-            },
-        )
-        .collect();
-    parts.into_iter().flatten().collect()
-}
 
 /// What `keep(i, &items[i])` returns, in the order of i (if `parallel`, fixed chunks on
 /// rayon's threads). Both paths run the same loop over a chunk, which `keep` is inlined
@@ -599,367 +390,4 @@ fn filter_in_order<T: Sync, U: Send>(items: &[T], parallel: bool, keep: impl Fn(
 /// Whether two boxes come within `margin` of each other.
 fn boxes_overlap(a: (DVec3, DVec3), b: (DVec3, DVec3), margin: f64) -> bool {
     (a.0 - DVec3::splat(margin)).cmple(b.1).all() && (a.1 + DVec3::splat(margin)).cmpge(b.0).all()
-}
-
-fn mean_edge(x: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
-    let sum: f64 = triangles.iter().take(64).map(|t| (x[t[1] as usize] - x[t[0] as usize]).length()).sum();
-    sum / triangles.len().clamp(1, 64) as f64
-}
-
-/// Groups of vertices of pairs that cross over the step, among the `near` pairs (which must
-/// cover the step's paths).
-fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], near: &NearPairs, eps: f64) -> Vec<Vec<u32>> {
-    let swept = |i: usize| (start[i].min(end[i]), start[i].max(end[i]));
-    let moving = |i: usize| start[i] != end[i];
-    let path = |i: usize| [start[i], end[i]];
-    let parallel = triangles.len() >= PARALLEL_TRIANGLES;
-    let mut found = filter_in_order(&near.vertex_triangle, parallel, |_, &(v, t)| {
-        let (p, tri) = (v as usize, triangles[t as usize]);
-        let c = tri.map(|i| i as usize);
-        if !moving(p) && c.iter().all(|&i| !moving(i)) {
-            return None;
-        }
-        let lo = c.iter().fold(DVec3::INFINITY, |a, &i| a.min(swept(i).0));
-        let hi = c.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(swept(i).1));
-        if !boxes_overlap(swept(p), (lo, hi), eps) {
-            return None;
-        }
-        vertex_triangle_ccd(path(p), path(c[0]), path(c[1]), path(c[2]), eps).map(|_| vec![v, tri[0], tri[1], tri[2]])
-    });
-    found.extend(filter_in_order(&near.edge_edge, parallel, |_, &(e, f)| {
-        let [a, b] = edges[e as usize].map(|i| i as usize);
-        let [c, d] = edges[f as usize].map(|i| i as usize);
-        if !moving(a) && !moving(b) && !moving(c) && !moving(d) {
-            return None;
-        }
-        let one = (swept(a).0.min(swept(b).0), swept(a).1.max(swept(b).1));
-        let other = (swept(c).0.min(swept(d).0), swept(c).1.max(swept(d).1));
-        if !boxes_overlap(one, other, eps) {
-            return None;
-        }
-        edge_edge_ccd(path(a), path(b), path(c), path(d), eps).map(|_| vec![a as u32, b as u32, c as u32, d as u32])
-    }));
-    found
-}
-
-/// Edge–triangle crossings in a mesh (edges that share no vertex with the triangle).
-pub fn count_self_intersections(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]]) -> usize {
-    let cell = mean_edge(x, triangles).max(1e-6);
-    let boxes: Vec<_> = triangles
-        .iter()
-        .map(|tri| {
-            let c = tri.map(|i| x[i as usize]);
-            (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
-        })
-        .collect();
-    let hash = SpatialHash::new(cell, &boxes);
-    let mut count = 0;
-    let mut seen = Vec::new();
-    for [a, b] in edges {
-        let (p, q) = (x[*a as usize], x[*b as usize]);
-        seen.clear();
-        hash.query_box(p.min(q), p.max(q), |t| {
-            if !seen.contains(&t) {
-                seen.push(t);
-            }
-        });
-        for &t in &seen {
-            let tri = triangles[t as usize];
-            if tri.contains(a) || tri.contains(b) {
-                continue;
-            }
-            let c = tri.map(|i| x[i as usize]);
-            if segment_crosses_triangle(p, q, c[0], c[1], c[2]) {
-                count += 1;
-            }
-        }
-    }
-    count
-}
-
-impl StepContacts {
-    pub fn is_empty(&self) -> bool {
-        self.planes.is_empty() && self.pairs.is_empty()
-    }
-
-    pub fn plane_count(&self) -> usize {
-        self.planes.len()
-    }
-
-    pub fn pair_count(&self) -> usize {
-        self.pairs.len()
-    }
-
-    /// Friction dissipation function F(s) and F'(s) of the tangential slip s over the step.
-    fn friction(&self, s: f64) -> (f64, f64) {
-        let (e, ms, mk) = (self.slip, self.mu_static, self.mu_kinetic);
-        if s <= e {
-            (ms * s * s / (2.0 * e), ms * s / e)
-        } else {
-            let decay = (-(s - e) / e).exp();
-            (ms * e / 2.0 + mk * (s - e) + (ms - mk) * e * (1.0 - decay), mk + (ms - mk) * decay)
-        }
-    }
-
-    /// Distance of a pair at `y`, the unit direction from the second part to the first, and
-    /// the weights c with d = n·Σ c_j y_j (to first order).
-    fn self_distance(&self, pair: &SelfPair, y: &[DVec3]) -> (f64, DVec3, [f64; 4]) {
-        let p = pair.vertices.map(|i| y[i as usize]);
-        let (offset, weights) = if pair.edge_edge {
-            let (s, t) = closest_points_segments(p[0], p[1], p[2], p[3]);
-            (p[0].lerp(p[1], s) - p[2].lerp(p[3], t), [1.0 - s, s, t - 1.0, -t])
-        } else {
-            let (q, w) = closest_point_triangle(p[0], p[1], p[2], p[3]);
-            (p[0] - q, [1.0, -w[0], -w[1], -w[2]])
-        };
-        let d = offset.length();
-        (d, if d > 1e-15 { offset / d } else { DVec3::Z }, weights)
-    }
-
-    /// Contact energy plus friction dissipation at positions `y`; `anchor` is x̂ (the
-    /// position the step's velocity is measured from).
-    pub fn energy(&self, y: &[DVec3], anchor: &[DVec3]) -> f64 {
-        let mut e = 0.0;
-        for c in &self.planes {
-            let i = c.vertex as usize;
-            let gap = self.thickness - c.normal.dot(y[i] - c.point);
-            if gap > 0.0 {
-                e += 0.5 * c.stiffness * gap * gap;
-            }
-            if c.normal_force > 0.0 {
-                let u = y[i] - anchor[i];
-                let slip = (u - u.dot(c.normal) * c.normal).length();
-                e += c.normal_force * self.friction(slip).0;
-            }
-        }
-        for p in &self.pairs {
-            let (d, _, _) = self.self_distance(p, y);
-            if d < self.self_thickness {
-                e += 0.5 * p.stiffness * (self.self_thickness - d).powi(2);
-            }
-        }
-        e
-    }
-
-    /// Adds ∇(energy) to `g`.
-    pub fn add_gradient(&self, y: &[DVec3], anchor: &[DVec3], g: &mut [DVec3], fixed: &[bool]) {
-        for c in &self.planes {
-            let i = c.vertex as usize;
-            let gap = self.thickness - c.normal.dot(y[i] - c.point);
-            if gap > 0.0 {
-                g[i] -= c.stiffness * gap * c.normal;
-            }
-            if c.normal_force > 0.0 {
-                let u = y[i] - anchor[i];
-                let t = u - u.dot(c.normal) * c.normal;
-                let slip = t.length();
-                if slip > 0.0 {
-                    g[i] += c.normal_force * self.friction(slip).1 * t / slip;
-                }
-            }
-        }
-        for p in &self.pairs {
-            let (d, n, w) = self.self_distance(p, y);
-            if d < self.self_thickness {
-                let f = p.stiffness * (self.self_thickness - d);
-                for (&j, &weight) in p.vertices.iter().zip(&w) {
-                    if !fixed[j as usize] {
-                        g[j as usize] -= f * weight * n;
-                    }
-                }
-            }
-        }
-    }
-
-    /// Adds a positive semi-definite approximation of the energy's Hessian to the diagonal
-    /// blocks of `k`; the cloth–cloth pairs' off-diagonal parts come from
-    /// [`StepContacts::couplings`]. Both are Gauss–Newton (the normal's rotation is left
-    /// out), which keeps the system positive definite.
-    pub fn add_hessian(&self, y: &[DVec3], anchor: &[DVec3], k: &mut BlockCsr) {
-        for c in &self.planes {
-            let i = c.vertex as usize;
-            let mut block = DMat3::ZERO;
-            if self.thickness - c.normal.dot(y[i] - c.point) > 0.0 {
-                block += c.stiffness * outer(c.normal, c.normal);
-            }
-            if c.normal_force > 0.0 {
-                // λF(s) of the slip s = |u_T|: curvature λF'(s)/s across the slip and λF''(s)
-                // along it. Sticking (s ≤ ε), F is quadratic and both are μ_s/ε. Sliding,
-                // F'' < 0 as μ decays to μ_k; 0 is used there. λF'(s)/s along the slip would
-                // be up to μ_s/ε·λ: twenty times a resting vertex's inertia at the drape's slip
-                // threshold, and with it Newton creeps along a sliding vertex's path at 0.3 µm
-                // an iteration.
-                let u = y[i] - anchor[i];
-                let t = u - u.dot(c.normal) * c.normal;
-                let slip = t.length();
-                let tangent = DMat3::IDENTITY - outer(c.normal, c.normal);
-                let (_, dfriction) = self.friction(slip.max(self.slip));
-                block += tangent * (c.normal_force * dfriction / slip.max(self.slip));
-                if slip > self.slip {
-                    let along = t / slip;
-                    block -= outer(along, along) * (c.normal_force * dfriction / slip);
-                }
-            }
-            let slot = k.diagonal_slot(i as u32);
-            k.values[slot] += block;
-        }
-        for p in &self.pairs {
-            let (d, n, w) = self.self_distance(p, y);
-            if d < self.self_thickness {
-                let nn = outer(n, n) * p.stiffness;
-                for (&j, &weight) in p.vertices.iter().zip(&w) {
-                    let slot = k.diagonal_slot(j);
-                    k.values[slot] += nn * (weight * weight);
-                }
-            }
-        }
-    }
-}
-
-impl StepContacts {
-    /// Makes prop contact inelastic: a vertex still inside its contact layer at the end of
-    /// the step keeps no velocity away from the prop. The penalty is a spring, and BDF2,
-    /// which hardly damps, would otherwise give back its energy as a bounce (a dropped
-    /// cloth jumped back to 90 % of its height); cloth does not bounce.
-    /// Returns the vertices whose velocity changed.
-    pub fn absorb_rebound(&self, y: &[DVec3], v: &mut [DVec3]) -> Vec<u32> {
-        let mut changed = Vec::new();
-        for c in &self.planes {
-            let i = c.vertex as usize;
-            let outward = v[i].dot(c.normal);
-            if outward > 0.0 && self.thickness - c.normal.dot(y[i] - c.point) > 0.0 {
-                v[i] -= outward * c.normal;
-                changed.push(c.vertex);
-            }
-        }
-        changed
-    }
-
-    /// Largest fraction of the Newton direction `d` from `y` along which no cloth–cloth
-    /// pair can meet (additive CCD, Li et al. 2021): a pair at distance g whose vertices move
-    /// at most |d_p| + max|d_j| cannot close that gap over a step shorter than g divided by it.
-    /// Capping each line search there keeps every Newton iterate free of crossings, so the
-    /// solve cannot carry a vertex around a triangle's edge to the far side.
-    pub fn max_step(&self, y: &[DVec3], d: &[DVec3]) -> f64 {
-        self.step_limit(y, d).min(1.0)
-    }
-
-    /// The multiple of `d` (any size) from `y` up to which no cloth–cloth pair can meet; see
-    /// [`Self::max_step`].
-    pub fn step_limit(&self, y: &[DVec3], d: &[DVec3]) -> f64 {
-        let mut alpha = f64::INFINITY;
-        for p in &self.pairs {
-            let v = p.vertices.map(|i| d[i as usize].length());
-            let bound = if p.edge_edge { v[0].max(v[1]) + v[2].max(v[3]) } else { v[0] + v[1].max(v[2]).max(v[3]) };
-            if bound > 0.0 {
-                let (gap, _, _) = self.self_distance(p, y);
-                alpha = alpha.min(0.9 * gap / bound);
-            }
-        }
-        alpha.max(0.0)
-    }
-
-    /// The rank-one Gauss–Newton terms of the active cloth–cloth pairs at `y`.
-    pub fn couplings(&self, y: &[DVec3], out: &mut Vec<Coupling>) {
-        for p in &self.pairs {
-            let (d, n, w) = self.self_distance(p, y);
-            if d < self.self_thickness {
-                out.push(Coupling {
-                    vertices: p.vertices,
-                    weights: w,
-                    normal: n,
-                    stiffness: p.stiffness,
-                });
-            }
-        }
-    }
-}
-
-fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sim::mesh::{Mesh, Pattern};
-    use crate::sim::model::{PhysicsOptions, tests::test_fabric};
-    use glam::DVec2;
-    use std::collections::BTreeSet;
-
-    /// Every pair the step's search must find, by testing all of them.
-    fn all_pairs(model: &Model, start: &[DVec3], predicted: &[DVec3], delta: f64) -> BTreeSet<([u32; 4], bool)> {
-        let motion = |i: usize| start[i].distance(predicted[i]);
-        let mut found = BTreeSet::new();
-        for (v, &p) in start.iter().enumerate() {
-            for tri in &model.triangles {
-                if tri.contains(&(v as u32)) {
-                    continue;
-                }
-                let c = tri.map(|i| i as usize);
-                let reach = delta + motion(v) + c.iter().map(|&i| motion(i)).fold(0.0, f64::max);
-                let (q, _) = closest_point_triangle(p, start[c[0]], start[c[1]], start[c[2]]);
-                if (q - p).length() < reach {
-                    found.insert(([v as u32, tri[0], tri[1], tri[2]], false));
-                }
-            }
-        }
-        for (e, &[a, b]) in model.edges.iter().enumerate() {
-            for &[c, d] in &model.edges[e + 1..] {
-                if c == a || c == b || d == a || d == b {
-                    continue;
-                }
-                let [a, b, c, d] = [a, b, c, d].map(|i| i as usize);
-                let reach = delta + motion(a).max(motion(b)) + motion(c).max(motion(d));
-                let (s, t) = closest_points_segments(start[a], start[b], start[c], start[d]);
-                if (start[a].lerp(start[b], s) - start[c].lerp(start[d], t)).length() < reach {
-                    found.insert(([a, b, c, d].map(|i| i as u32), true));
-                }
-            }
-        }
-        found
-    }
-
-    /// A strip folded over itself, its layers sliding past each other: the near-pair
-    /// list, kept or renewed, must give exactly the pairs an exhaustive search gives.
-    #[test]
-    fn near_pair_list_finds_every_pair_an_exhaustive_search_finds() {
-        let total = folded_strip_pairs(0.004, 12);
-        assert!(total > 100, "the fold should bring many pairs within reach: {total}");
-    }
-
-    /// The same on a mesh of over `PARALLEL_TRIANGLES` triangles, whose searches run in
-    /// chunks on rayon's threads.
-    #[test]
-    fn searches_in_parallel_find_every_pair_too() {
-        let total = folded_strip_pairs(0.00058, 2);
-        assert!(total > 1000, "the fold should bring many pairs within reach: {total}");
-    }
-
-    /// Pairs over `steps` steps of the folded strip meshed at `edge`, checked against the
-    /// exhaustive search; returns how many there were.
-    fn folded_strip_pairs(edge: f64, steps: usize) -> usize {
-        let mesh = Mesh::rectangle(0.04, 0.02, edge, Pattern::Regular, 0).unwrap();
-        let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
-        assert_eq!(model.triangles.len() >= PARALLEL_TRIANGLES, edge < 0.001, "{} triangles", model.triangles.len());
-        let settings = ContactSettings { self_collision: true, self_thickness: 0.002, ..Default::default() };
-        let contact = ContactModel::new(Vec::new(), settings).unwrap();
-        let folded = |p: DVec2, drift: DVec3| {
-            // The layers drift apart in opposite directions, as closing pairs would.
-            if p.x <= 0.02 { DVec3::new(p.x, p.y, 0.0) - drift * (0.02 - p.x) / 0.02 } else { DVec3::new(0.04 - p.x, p.y, 0.0015) + drift * (p.x - 0.02) / 0.02 }
-        };
-        let mut total = 0;
-        for step in 0..steps {
-            let t = step as f64;
-            let drift = |t: f64| DVec3::new(0.0015 * t, 0.001 * (0.7 * t).sin(), -0.0001 * t);
-            let start: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, drift(t))).collect();
-            let predicted: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, drift(t + 1.0))).collect();
-            let contacts = contact.begin_step(&model, &start, &predicted, 0.004);
-            let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
-            assert_eq!(listed.len(), contacts.pairs.len(), "step {step}: a pair listed twice");
-            assert_eq!(listed, all_pairs(&model, &start, &predicted, settings.self_thickness), "step {step}");
-            total += listed.len();
-        }
-        total
-    }
 }

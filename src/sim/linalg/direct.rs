@@ -11,8 +11,9 @@
 //! the ordering and the supernodes; the numeric factorisation and the triangular solves
 //! run on two threads (`supernodal`).
 
-use crate::sim::sparse::{SystemMatrix, merge_rows};
-use crate::sim::supernodal::SupernodalPlan;
+use super::storage::merge_rows;
+use super::system::SystemMatrix;
+use super::supernodal::SupernodalPlan;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};

@@ -1,0 +1,393 @@
+//! Cloth against itself: the near-pair list (a Verlet list found with a spatial hash),
+//! the pairs kept apart in each step's solve, and the continuous-collision fail-safe.
+
+use super::geometry::{SpatialHash, closest_point_triangle, closest_points_segments, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
+use super::{Cloth, ContactModel, PARALLEL_TRIANGLES, SelfPair, boxes_overlap, filter_in_order};
+use glam::DVec3;
+
+/// Cloth–cloth pairs closer than `reach` at positions `origin` (by their bounding boxes):
+/// contact's changing state, kept from step to step by the integrator that owns it (the
+/// props and settings, [`ContactModel`], are fixed).
+#[derive(Debug, Clone, Default)]
+pub struct NearPairs {
+    origin: Vec<DVec3>,
+    /// Triangle and edge counts of the cloth it was built for.
+    topology: (usize, usize),
+    reach: f64,
+    /// (vertex, triangle index).
+    vertex_triangle: Vec<(u32, u32)>,
+    /// (edge, edge) indices, first < second, sharing no vertex.
+    edge_edge: Vec<(u32, u32)>,
+}
+
+impl NearPairs {
+    /// Whether every pair that comes within `margin` while its vertices move at most
+    /// `motion` from `start` is listed: in the worst case two vertices have closed by
+    /// twice the largest displacement since the list was built and by twice `motion`.
+    fn covers(&self, cloth: Cloth, start: &[DVec3], motion: f64, margin: f64) -> bool {
+        if self.origin.len() != start.len() || self.topology != (cloth.triangles.len(), cloth.edges.len()) {
+            return false;
+        }
+        let moved = start.iter().zip(&self.origin).map(|(a, b)| a.distance_squared(*b)).fold(0.0, f64::max).sqrt();
+        2.0 * moved + 2.0 * motion + margin <= self.reach
+    }
+
+    fn build(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], reach: f64) -> Self {
+        let parallel = triangles.len() >= PARALLEL_TRIANGLES;
+        let cell = mean_edge(x, triangles).max(reach).max(1e-6);
+        let points: Vec<_> = x.iter().map(|&p| (p, p)).collect();
+        let hash = SpatialHash::new(cell, &points);
+        let pad = DVec3::splat(reach);
+        // The hash returns an item once per cell it overlaps (and its bucket-mates): each
+        // query marks what it has taken with its own number instead of searching a list of
+        // them, which took about a quarter of the search's time at 20 000 triangles.
+        let vertex_triangle = search_in_chunks(triangles.len(), x.len(), parallel, |t, taken, found| {
+            let tri = triangles[t];
+            let c = tri.map(|i| x[i as usize]);
+            let (lo, hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+            hash.query_box(lo - pad, hi + pad, |v| {
+                if taken[v as usize] != t as u32 && !tri.contains(&v) && boxes_overlap((x[v as usize], x[v as usize]), (lo, hi), reach) {
+                    taken[v as usize] = t as u32;
+                    found.push((v, t as u32));
+                }
+            });
+        });
+        let segment = |e: usize| {
+            let [a, b] = edges[e].map(|i| x[i as usize]);
+            (a.min(b), a.max(b))
+        };
+        let boxes: Vec<_> = (0..edges.len()).map(segment).collect();
+        let hash = SpatialHash::new(cell, &boxes);
+        let edge_edge = search_in_chunks(edges.len(), edges.len(), parallel, |e, taken, found| {
+            let [a, b] = edges[e];
+            hash.query_box(boxes[e].0 - pad, boxes[e].1 + pad, |f| {
+                let [c, d] = edges[f as usize];
+                if (f as usize) > e && taken[f as usize] != e as u32 && c != a && c != b && d != a && d != b && boxes_overlap(boxes[e], boxes[f as usize], reach) {
+                    taken[f as usize] = e as u32;
+                    found.push((e as u32, f));
+                }
+            });
+        });
+        Self { origin: x.to_vec(), topology: (triangles.len(), edges.len()), reach, vertex_triangle, edge_edge }
+    }
+}
+
+impl ContactModel {
+
+    /// The near-pair list for a search from `start` over paths of at most `motion` for
+    /// pairs that come within `margin`, renewed if it does not cover them.
+    fn near_pairs<'n>(cloth: Cloth, near: &'n mut NearPairs, start: &[DVec3], motion: f64, margin: f64) -> &'n NearPairs {
+        // The skin: half an edge lets a draping cloth keep its list for many steps while
+        // adding few pairs beyond those in reach.
+        let skin = 0.5 * cloth.mean_edge_length;
+        if !near.covers(cloth, start, motion, margin) {
+            *near = NearPairs::build(start, cloth.triangles, cloth.edges, margin + 2.0 * motion + skin);
+        }
+        near
+    }
+
+
+    /// Vertex–triangle and edge–edge pairs within reach over the step.
+    pub(super) fn self_pairs(&self, cloth: Cloth, near: &mut NearPairs, start: &[DVec3], predicted: &[DVec3], h: f64) -> Vec<SelfPair> {
+        let (fixed, mass, triangles, edges) = (cloth.fixed, cloth.mass, cloth.triangles, cloth.edges);
+        let parallel = triangles.len() >= PARALLEL_TRIANGLES;
+        let delta = self.settings.self_thickness;
+        let motion: Vec<f64> = start.iter().zip(predicted).map(|(a, b)| a.distance(*b)).collect();
+        let near = Self::near_pairs(cloth, near, start, motion.iter().copied().fold(0.0, f64::max), delta);
+        let stiffness = |m: f64| self.settings.stiffness * m / (h * h);
+        let mut pairs = filter_in_order(&near.vertex_triangle, parallel, |_, &(v, t)| {
+            let (vi, tri) = (v as usize, triangles[t as usize]);
+            let corners = tri.map(|i| i as usize);
+            if fixed[vi] && corners.iter().all(|&i| fixed[i]) {
+                return None;
+            }
+            let reach = delta + motion[vi] + corners.iter().map(|&i| motion[i]).fold(0.0, f64::max);
+            // The triangle's box at the start: a vertex farther from it than the reach is
+            // farther from the triangle too.
+            let c = corners.map(|i| start[i]);
+            if !boxes_overlap((start[vi], start[vi]), (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2])), reach) {
+                return None;
+            }
+            let (q, _) = closest_point_triangle(start[vi], c[0], c[1], c[2]);
+            ((q - start[vi]).length() < reach).then(|| {
+                let m = 0.25 * (mass[vi] + corners.iter().map(|&i| mass[i]).sum::<f64>());
+                SelfPair { vertices: [v, tri[0], tri[1], tri[2]], edge_edge: false, stiffness: stiffness(m) }
+            })
+        });
+        // Edges can pass through each other with every vertex far from every triangle.
+        pairs.extend(filter_in_order(&near.edge_edge, parallel, |_, &(e, f)| {
+            let [a, b] = edges[e as usize].map(|i| i as usize);
+            let [c, d] = edges[f as usize].map(|i| i as usize);
+            if fixed[a] && fixed[b] && fixed[c] && fixed[d] {
+                return None;
+            }
+            let reach = delta + motion[a].max(motion[b]) + motion[c].max(motion[d]);
+            let segment_box = |p: usize, q: usize| (start[p].min(start[q]), start[p].max(start[q]));
+            if !boxes_overlap(segment_box(a, b), segment_box(c, d), reach) {
+                return None;
+            }
+            let (sa, tb) = closest_points_segments(start[a], start[b], start[c], start[d]);
+            let gap = (start[a].lerp(start[b], sa) - start[c].lerp(start[d], tb)).length();
+            (gap < reach).then(|| {
+                let m = 0.25 * (mass[a] + mass[b] + mass[c] + mass[d]);
+                SelfPair { vertices: [a as u32, b as u32, c as u32, d as u32], edge_edge: true, stiffness: stiffness(m) }
+            })
+        }));
+        pairs
+    }
+
+
+    /// The continuous-collision fail-safe: finds vertex–triangle and edge–edge pairs that
+    /// cross between `start` and `end`, holds their vertices at `start` and gives each
+    /// impact zone its mean velocity. Returns the number of crossings stopped.
+    pub fn stop_self_crossings(&self, cloth: Cloth, near: &mut NearPairs, start: &[DVec3], end: &mut [DVec3], v: &mut [DVec3]) -> u64 {
+        let (mass, triangles, edges) = (cloth.mass, cloth.triangles, cloth.edges);
+        let n = start.len();
+        let eps = 1e-3 * self.settings.self_thickness;
+        let mut zone: Vec<u32> = (0..n as u32).collect();
+        fn root(zone: &mut [u32], mut i: u32) -> u32 {
+            while zone[i as usize] != i {
+                zone[i as usize] = zone[zone[i as usize] as usize];
+                i = zone[i as usize];
+            }
+            i
+        }
+        let mut stopped = 0u64;
+        let mut frozen = vec![false; n];
+        for _round in 0..50 {
+            let motion = start.iter().zip(end.iter()).map(|(a, b)| a.distance_squared(*b)).fold(0.0, f64::max).sqrt();
+            let crossings = find_crossings(start, end, triangles, edges, Self::near_pairs(cloth, near, start, motion, eps), eps);
+            if crossings.is_empty() {
+                break;
+            }
+            stopped += crossings.len() as u64;
+            for group in crossings {
+                let r0 = root(&mut zone, group[0]);
+                for &i in &group {
+                    let r = root(&mut zone, i);
+                    zone[r as usize] = r0;
+                    frozen[i as usize] = true;
+                }
+            }
+            for i in 0..n {
+                if frozen[i] {
+                    end[i] = start[i];
+                }
+            }
+        }
+        if stopped > 0 {
+            // Each zone moves on with its mass-weighted mean velocity (momentum kept).
+            let mut sums: std::collections::HashMap<u32, (DVec3, f64)> = std::collections::HashMap::new();
+            for i in 0..n {
+                if frozen[i] {
+                    let e = sums.entry(root(&mut zone, i as u32)).or_insert((DVec3::ZERO, 0.0));
+                    e.0 += mass[i] * v[i];
+                    e.1 += mass[i];
+                }
+            }
+            for i in 0..n {
+                if frozen[i] {
+                    let (p, m) = sums[&root(&mut zone, i as u32)];
+                    v[i] = p / m;
+                }
+            }
+        }
+        stopped
+    }
+}
+
+/// Runs `search(i, marks, found)` for every i < `count` and returns what it found, in the
+/// order of i whatever the number of threads (if `parallel`, fixed chunks on rayon's
+/// threads). `marks` holds `marks_len` entries, u32::MAX at first, for the search
+/// to mark what item i has taken with i: each thread keeps one array for its chunks, which
+/// is sound because no two items share a number.
+fn search_in_chunks<T: Send>(count: usize, marks_len: usize, parallel: bool, search: impl Fn(usize, &mut [u32], &mut Vec<T>) + Sync) -> Vec<T> {
+    use rayon::prelude::*;
+    const CHUNK: usize = 1024;
+    let run = |first: usize, marks: &mut [u32], found: &mut Vec<T>| {
+        let end = if parallel { (first + CHUNK).min(count) } else { count };
+        for i in first..end {
+            search(i, marks, found);
+        }
+    };
+    if !parallel {
+        let (mut marks, mut found) = (vec![u32::MAX; marks_len], Vec::new());
+        run(0, &mut marks, &mut found);
+        return found;
+    }
+    let parts: Vec<Vec<T>> = (0..count.div_ceil(CHUNK))
+        .into_par_iter()
+        .map_init(
+            || vec![u32::MAX; marks_len],
+            |marks, c| {
+                let mut found = Vec::new();
+                run(c * CHUNK, marks, &mut found);
+                found
+            },
+        )
+        .collect();
+    parts.into_iter().flatten().collect()
+}
+
+fn mean_edge(x: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    let sum: f64 = triangles.iter().take(64).map(|t| (x[t[1] as usize] - x[t[0] as usize]).length()).sum();
+    sum / triangles.len().clamp(1, 64) as f64
+}
+
+/// Groups of vertices of pairs that cross over the step, among the `near` pairs (which must
+/// cover the step's paths).
+fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], near: &NearPairs, eps: f64) -> Vec<Vec<u32>> {
+    let swept = |i: usize| (start[i].min(end[i]), start[i].max(end[i]));
+    let moving = |i: usize| start[i] != end[i];
+    let path = |i: usize| [start[i], end[i]];
+    let parallel = triangles.len() >= PARALLEL_TRIANGLES;
+    let mut found = filter_in_order(&near.vertex_triangle, parallel, |_, &(v, t)| {
+        let (p, tri) = (v as usize, triangles[t as usize]);
+        let c = tri.map(|i| i as usize);
+        if !moving(p) && c.iter().all(|&i| !moving(i)) {
+            return None;
+        }
+        let lo = c.iter().fold(DVec3::INFINITY, |a, &i| a.min(swept(i).0));
+        let hi = c.iter().fold(DVec3::NEG_INFINITY, |a, &i| a.max(swept(i).1));
+        if !boxes_overlap(swept(p), (lo, hi), eps) {
+            return None;
+        }
+        vertex_triangle_ccd(path(p), path(c[0]), path(c[1]), path(c[2]), eps).map(|_| vec![v, tri[0], tri[1], tri[2]])
+    });
+    found.extend(filter_in_order(&near.edge_edge, parallel, |_, &(e, f)| {
+        let [a, b] = edges[e as usize].map(|i| i as usize);
+        let [c, d] = edges[f as usize].map(|i| i as usize);
+        if !moving(a) && !moving(b) && !moving(c) && !moving(d) {
+            return None;
+        }
+        let one = (swept(a).0.min(swept(b).0), swept(a).1.max(swept(b).1));
+        let other = (swept(c).0.min(swept(d).0), swept(c).1.max(swept(d).1));
+        if !boxes_overlap(one, other, eps) {
+            return None;
+        }
+        edge_edge_ccd(path(a), path(b), path(c), path(d), eps).map(|_| vec![a as u32, b as u32, c as u32, d as u32])
+    }));
+    found
+}
+
+/// Edge–triangle crossings in a mesh (edges that share no vertex with the triangle).
+pub fn count_self_intersections(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]]) -> usize {
+    let cell = mean_edge(x, triangles).max(1e-6);
+    let boxes: Vec<_> = triangles
+        .iter()
+        .map(|tri| {
+            let c = tri.map(|i| x[i as usize]);
+            (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
+        })
+        .collect();
+    let hash = SpatialHash::new(cell, &boxes);
+    let mut count = 0;
+    let mut seen = Vec::new();
+    for [a, b] in edges {
+        let (p, q) = (x[*a as usize], x[*b as usize]);
+        seen.clear();
+        hash.query_box(p.min(q), p.max(q), |t| {
+            if !seen.contains(&t) {
+                seen.push(t);
+            }
+        });
+        for &t in &seen {
+            let tri = triangles[t as usize];
+            if tri.contains(a) || tri.contains(b) {
+                continue;
+            }
+            let c = tri.map(|i| x[i as usize]);
+            if segment_crosses_triangle(p, q, c[0], c[1], c[2]) {
+                count += 1;
+            }
+        }
+    }
+    count
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::contact::ContactSettings;
+    use crate::sim::mesh::{Mesh, Pattern};
+    use crate::sim::model::{Model, PhysicsOptions, tests::test_fabric};
+    use glam::DVec2;
+    use std::collections::BTreeSet;
+
+    /// Every pair the step's search must find, by testing all of them.
+    fn all_pairs(model: &Model, start: &[DVec3], predicted: &[DVec3], delta: f64) -> BTreeSet<([u32; 4], bool)> {
+        let motion = |i: usize| start[i].distance(predicted[i]);
+        let mut found = BTreeSet::new();
+        for (v, &p) in start.iter().enumerate() {
+            for tri in &model.triangles {
+                if tri.contains(&(v as u32)) {
+                    continue;
+                }
+                let c = tri.map(|i| i as usize);
+                let reach = delta + motion(v) + c.iter().map(|&i| motion(i)).fold(0.0, f64::max);
+                let (q, _) = closest_point_triangle(p, start[c[0]], start[c[1]], start[c[2]]);
+                if (q - p).length() < reach {
+                    found.insert(([v as u32, tri[0], tri[1], tri[2]], false));
+                }
+            }
+        }
+        for (e, &[a, b]) in model.edges.iter().enumerate() {
+            for &[c, d] in &model.edges[e + 1..] {
+                if c == a || c == b || d == a || d == b {
+                    continue;
+                }
+                let [a, b, c, d] = [a, b, c, d].map(|i| i as usize);
+                let reach = delta + motion(a).max(motion(b)) + motion(c).max(motion(d));
+                let (s, t) = closest_points_segments(start[a], start[b], start[c], start[d]);
+                if (start[a].lerp(start[b], s) - start[c].lerp(start[d], t)).length() < reach {
+                    found.insert(([a, b, c, d].map(|i| i as u32), true));
+                }
+            }
+        }
+        found
+    }
+
+    /// A strip folded over itself, its layers sliding past each other: the near-pair
+    /// list, kept or renewed, must give exactly the pairs an exhaustive search gives.
+    #[test]
+    fn near_pair_list_finds_every_pair_an_exhaustive_search_finds() {
+        let total = folded_strip_pairs(0.004, 12);
+        assert!(total > 100, "the fold should bring many pairs within reach: {total}");
+    }
+
+    /// The same on a mesh of over `PARALLEL_TRIANGLES` triangles, whose searches run in
+    /// chunks on rayon's threads.
+    #[test]
+    fn searches_in_parallel_find_every_pair_too() {
+        let total = folded_strip_pairs(0.00058, 2);
+        assert!(total > 1000, "the fold should bring many pairs within reach: {total}");
+    }
+
+    /// Pairs over `steps` steps of the folded strip meshed at `edge`, checked against the
+    /// exhaustive search; returns how many there were.
+    fn folded_strip_pairs(edge: f64, steps: usize) -> usize {
+        let mesh = Mesh::rectangle(0.04, 0.02, edge, Pattern::Regular, 0).unwrap();
+        let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
+        assert_eq!(model.triangles.len() >= PARALLEL_TRIANGLES, edge < 0.001, "{} triangles", model.triangles.len());
+        let settings = ContactSettings { self_collision: true, self_thickness: 0.002, ..Default::default() };
+        let contact = ContactModel::new(Vec::new(), settings).unwrap();
+        let folded = |p: DVec2, drift: DVec3| {
+            // The layers drift apart in opposite directions, as closing pairs would.
+            if p.x <= 0.02 { DVec3::new(p.x, p.y, 0.0) - drift * (0.02 - p.x) / 0.02 } else { DVec3::new(0.04 - p.x, p.y, 0.0015) + drift * (p.x - 0.02) / 0.02 }
+        };
+        let mut total = 0;
+        let mut near = NearPairs::default();
+        for step in 0..steps {
+            let t = step as f64;
+            let drift = |t: f64| DVec3::new(0.0015 * t, 0.001 * (0.7 * t).sin(), -0.0001 * t);
+            let start: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, drift(t))).collect();
+            let predicted: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, drift(t + 1.0))).collect();
+            let contacts = contact.begin_step(model.cloth(), &mut near, &start, &predicted, 0.004);
+            let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
+            assert_eq!(listed.len(), contacts.pairs.len(), "step {step}: a pair listed twice");
+            assert_eq!(listed, all_pairs(&model, &start, &predicted, settings.self_thickness), "step {step}");
+            total += listed.len();
+        }
+        total
+    }
+}

@@ -1,0 +1,209 @@
+//! The contacts of one step as energies in the implicit solve: their potential, gradient,
+//! Hessian and couplings, and the step limits that keep cloth–cloth pairs from meeting.
+
+use super::{SelfPair, StepContacts};
+use super::geometry::{closest_point_triangle, closest_points_segments};
+use crate::sim::linalg::{BlockCsr, Coupling};
+use glam::{DMat3, DVec3};
+
+impl StepContacts {
+    pub fn is_empty(&self) -> bool {
+        self.planes.is_empty() && self.pairs.is_empty()
+    }
+
+    pub fn plane_count(&self) -> usize {
+        self.planes.len()
+    }
+
+    pub fn pair_count(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Friction dissipation function F(s) and F'(s) of the tangential slip s over the step.
+    fn friction(&self, s: f64) -> (f64, f64) {
+        let (e, ms, mk) = (self.slip, self.mu_static, self.mu_kinetic);
+        if s <= e {
+            (ms * s * s / (2.0 * e), ms * s / e)
+        } else {
+            let decay = (-(s - e) / e).exp();
+            (ms * e / 2.0 + mk * (s - e) + (ms - mk) * e * (1.0 - decay), mk + (ms - mk) * decay)
+        }
+    }
+
+    /// Distance of a pair at `y`, the unit direction from the second part to the first, and
+    /// the weights c with d = n·Σ c_j y_j (to first order).
+    fn self_distance(&self, pair: &SelfPair, y: &[DVec3]) -> (f64, DVec3, [f64; 4]) {
+        let p = pair.vertices.map(|i| y[i as usize]);
+        let (offset, weights) = if pair.edge_edge {
+            let (s, t) = closest_points_segments(p[0], p[1], p[2], p[3]);
+            (p[0].lerp(p[1], s) - p[2].lerp(p[3], t), [1.0 - s, s, t - 1.0, -t])
+        } else {
+            let (q, w) = closest_point_triangle(p[0], p[1], p[2], p[3]);
+            (p[0] - q, [1.0, -w[0], -w[1], -w[2]])
+        };
+        let d = offset.length();
+        (d, if d > 1e-15 { offset / d } else { DVec3::Z }, weights)
+    }
+
+    /// Contact energy plus friction dissipation at positions `y`; `anchor` is x̂ (the
+    /// position the step's velocity is measured from).
+    pub fn energy(&self, y: &[DVec3], anchor: &[DVec3]) -> f64 {
+        let mut e = 0.0;
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let gap = self.thickness - c.normal.dot(y[i] - c.point);
+            if gap > 0.0 {
+                e += 0.5 * c.stiffness * gap * gap;
+            }
+            if c.normal_force > 0.0 {
+                let u = y[i] - anchor[i];
+                let slip = (u - u.dot(c.normal) * c.normal).length();
+                e += c.normal_force * self.friction(slip).0;
+            }
+        }
+        for p in &self.pairs {
+            let (d, _, _) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                e += 0.5 * p.stiffness * (self.self_thickness - d).powi(2);
+            }
+        }
+        e
+    }
+
+    /// Adds ∇(energy) to `g`.
+    pub fn add_gradient(&self, y: &[DVec3], anchor: &[DVec3], g: &mut [DVec3], fixed: &[bool]) {
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let gap = self.thickness - c.normal.dot(y[i] - c.point);
+            if gap > 0.0 {
+                g[i] -= c.stiffness * gap * c.normal;
+            }
+            if c.normal_force > 0.0 {
+                let u = y[i] - anchor[i];
+                let t = u - u.dot(c.normal) * c.normal;
+                let slip = t.length();
+                if slip > 0.0 {
+                    g[i] += c.normal_force * self.friction(slip).1 * t / slip;
+                }
+            }
+        }
+        for p in &self.pairs {
+            let (d, n, w) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                let f = p.stiffness * (self.self_thickness - d);
+                for (&j, &weight) in p.vertices.iter().zip(&w) {
+                    if !fixed[j as usize] {
+                        g[j as usize] -= f * weight * n;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds a positive semi-definite approximation of the energy's Hessian to the diagonal
+    /// blocks of `k`; the cloth–cloth pairs' off-diagonal parts come from
+    /// [`StepContacts::couplings`]. Both are Gauss–Newton (the normal's rotation is left
+    /// out), which keeps the system positive definite.
+    pub fn add_hessian(&self, y: &[DVec3], anchor: &[DVec3], k: &mut BlockCsr) {
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let mut block = DMat3::ZERO;
+            if self.thickness - c.normal.dot(y[i] - c.point) > 0.0 {
+                block += c.stiffness * outer(c.normal, c.normal);
+            }
+            if c.normal_force > 0.0 {
+                // λF(s) of the slip s = |u_T|: curvature λF'(s)/s across the slip and λF''(s)
+                // along it. Sticking (s ≤ ε), F is quadratic and both are μ_s/ε. Sliding,
+                // F'' < 0 as μ decays to μ_k; 0 is used there. λF'(s)/s along the slip would
+                // be up to μ_s/ε·λ: twenty times a resting vertex's inertia at the drape's slip
+                // threshold, and with it Newton creeps along a sliding vertex's path at 0.3 µm
+                // an iteration.
+                let u = y[i] - anchor[i];
+                let t = u - u.dot(c.normal) * c.normal;
+                let slip = t.length();
+                let tangent = DMat3::IDENTITY - outer(c.normal, c.normal);
+                let (_, dfriction) = self.friction(slip.max(self.slip));
+                block += tangent * (c.normal_force * dfriction / slip.max(self.slip));
+                if slip > self.slip {
+                    let along = t / slip;
+                    block -= outer(along, along) * (c.normal_force * dfriction / slip);
+                }
+            }
+            let slot = k.diagonal_slot(i as u32);
+            k.values[slot] += block;
+        }
+        for p in &self.pairs {
+            let (d, n, w) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                let nn = outer(n, n) * p.stiffness;
+                for (&j, &weight) in p.vertices.iter().zip(&w) {
+                    let slot = k.diagonal_slot(j);
+                    k.values[slot] += nn * (weight * weight);
+                }
+            }
+        }
+    }
+}
+
+impl StepContacts {
+    /// Makes prop contact inelastic: a vertex still inside its contact layer at the end of
+    /// the step keeps no velocity away from the prop. The penalty is a spring, and BDF2,
+    /// which hardly damps, would otherwise give back its energy as a bounce (a dropped
+    /// cloth jumped back to 90 % of its height); cloth does not bounce.
+    /// Returns the vertices whose velocity changed.
+    pub fn absorb_rebound(&self, y: &[DVec3], v: &mut [DVec3]) -> Vec<u32> {
+        let mut changed = Vec::new();
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let outward = v[i].dot(c.normal);
+            if outward > 0.0 && self.thickness - c.normal.dot(y[i] - c.point) > 0.0 {
+                v[i] -= outward * c.normal;
+                changed.push(c.vertex);
+            }
+        }
+        changed
+    }
+
+    /// Largest fraction of the Newton direction `d` from `y` along which no cloth–cloth
+    /// pair can meet (additive CCD, Li et al. 2021): a pair at distance g whose vertices move
+    /// at most |d_p| + max|d_j| cannot close that gap over a step shorter than g divided by it.
+    /// Capping each line search there keeps every Newton iterate free of crossings, so the
+    /// solve cannot carry a vertex around a triangle's edge to the far side.
+    pub fn max_step(&self, y: &[DVec3], d: &[DVec3]) -> f64 {
+        self.step_limit(y, d).min(1.0)
+    }
+
+    /// The multiple of `d` (any size) from `y` up to which no cloth–cloth pair can meet; see
+    /// [`Self::max_step`].
+    pub fn step_limit(&self, y: &[DVec3], d: &[DVec3]) -> f64 {
+        let mut alpha = f64::INFINITY;
+        for p in &self.pairs {
+            let v = p.vertices.map(|i| d[i as usize].length());
+            let bound = if p.edge_edge { v[0].max(v[1]) + v[2].max(v[3]) } else { v[0] + v[1].max(v[2]).max(v[3]) };
+            if bound > 0.0 {
+                let (gap, _, _) = self.self_distance(p, y);
+                alpha = alpha.min(0.9 * gap / bound);
+            }
+        }
+        alpha.max(0.0)
+    }
+
+    /// The rank-one Gauss–Newton terms of the active cloth–cloth pairs at `y`.
+    pub fn couplings(&self, y: &[DVec3], out: &mut Vec<Coupling>) {
+        for p in &self.pairs {
+            let (d, n, w) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                out.push(Coupling {
+                    vertices: p.vertices,
+                    weights: w,
+                    normal: n,
+                    stiffness: p.stiffness,
+                });
+            }
+        }
+    }
+}
+
+fn outer(a: DVec3, b: DVec3) -> DMat3 {
+    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}

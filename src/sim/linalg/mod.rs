@@ -1,0 +1,25 @@
+//! Linear algebra for Newton's systems: sparse storage on the mesh's fixed pattern, the
+//! system matrix, the conjugate gradient and its preconditioners.
+//!
+//! Dependencies point one way: `storage` ← `system` ← the factors (`incomplete`, `direct`
+//! with `supernodal`, `multigrid`) ← `preconditioner` (the one enum naming them all) ←
+//! `cg`.
+
+mod cg;
+pub mod direct;
+mod incomplete;
+pub mod multigrid;
+mod preconditioner;
+mod storage;
+pub mod supernodal;
+mod system;
+#[cfg(test)]
+mod tests;
+
+pub use cg::{CgReport, pcg};
+pub use direct::{DirectFactor, DirectPattern};
+pub use incomplete::IncompleteCholesky;
+pub use multigrid::Multigrid;
+pub use preconditioner::Preconditioner;
+pub use storage::{BlockCsr, ScalarCsr};
+pub use system::{Coupling, SystemMatrix};

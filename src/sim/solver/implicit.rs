@@ -1,0 +1,138 @@
+//! The implicit step: implicit Euler and BDF2 as one minimisation of the incremental
+//! potential, with contact inside it.
+
+use super::report::{Stopwatch, StepReport};
+use super::{Integrator, State};
+use crate::sim::model::Model;
+use glam::DVec3;
+
+impl Integrator {
+    /// One implicit Euler (or, with `bdf2` and a history, BDF2) step of `s`, in place.
+    pub(super) fn implicit(&mut self, model: &Model, s: &mut State, bdf2: bool) -> StepReport {
+        let n = s.x.len();
+        let dt = self.dt;
+        // Both methods minimise Φ(y) = Σ m/(2h²)|y − x̃|² + Σ ζm/(2h)|y − x̂|² + E(y) and set
+        // v = (y − x̂)/h. Implicit Euler: h = Δt, x̂ = x_n, x̃ = x_n + h v_n. BDF2:
+        // h = 2Δt/3, x̂ = (4x_n − x_{n−1})/3, x̃ = x̂ + h(4v_n − v_{n−1})/3.
+        let (h, anchor, inertial): (f64, Vec<DVec3>, Vec<DVec3>) = match (&s.previous, bdf2) {
+            (Some((xp, vp)), true) => {
+                let h = 2.0 * dt / 3.0;
+                let anchor: Vec<DVec3> = (0..n).map(|i| (4.0 * s.x[i] - xp[i]) / 3.0).collect();
+                let inertial = (0..n).map(|i| anchor[i] + h * (4.0 * s.v[i] - vp[i]) / 3.0).collect();
+                (h, anchor, inertial)
+            }
+            _ => (dt, s.x.clone(), (0..n).map(|i| s.x[i] + dt * s.v[i]).collect()),
+        };
+        let t_next = s.time + dt;
+        let step = ImplicitStep { model, h, anchor: &anchor, inertial: &inertial };
+        let prescribe = |mut y: Vec<DVec3>| {
+            for (i, yi) in y.iter_mut().enumerate() {
+                if model.fixed[i] {
+                    *yi = model.prescribed_position(i, t_next);
+                }
+            }
+            y
+        };
+        let mut y = prescribe(inertial.clone());
+        if let (Some((_, vp)), true) = (&s.previous, self.newton.warm_start) {
+            // Where the last step's acceleration would carry the cloth; kept only if it is
+            // the better start (it is not when the motion reverses, as in a vibration).
+            let extrapolated = prescribe((0..n).map(|i| s.x[i] + dt * (2.0 * s.v[i] - vp[i])).collect());
+            if step.potential(&extrapolated) < step.potential(&y) {
+                y = extrapolated;
+            }
+        }
+        let mut report = StepReport::default();
+        let mut step_contacts = None;
+        match &model.contact {
+            None => self.newton(&step, None, &mut y, &mut report),
+            Some(contact) => {
+                let mut watch = Stopwatch::start();
+                // The prediction includes gravity's pull over the step, so that contacts a
+                // falling cloth is about to make are there from the first iteration.
+                let predicted: Vec<DVec3> = (0..n).map(|i| inertial[i] + h * h * model.options.gravity).collect();
+                let mut contacts = contact.begin_step(model.cloth(), &mut self.near_pairs, &s.x, &predicted, h);
+                // Newton's path must start where the cloth is: jumping straight to the
+                // inertial guess could carry a vertex through a layer before any contact
+                // force acts. Start from x_n moved towards the guess as far as no cloth–cloth
+                // pair can meet.
+                if contacts.pair_count() > 0 {
+                    let guess: Vec<DVec3> = (0..n).map(|i| if model.fixed[i] { DVec3::ZERO } else { y[i] - s.x[i] }).collect();
+                    let alpha = contacts.max_step(&s.x, &guess);
+                    for i in 0..n {
+                        if !model.fixed[i] {
+                            y[i] = s.x[i] + alpha * guess[i];
+                        }
+                    }
+                }
+                watch.contact();
+                // Solve; a path that enters a prop without a plane adds one and solves again.
+                for pass in 0..4 {
+                    self.newton(&step, Some(&contacts), &mut y, &mut report);
+                    watch.restart();
+                    let missed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &y, h);
+                    watch.contact();
+                    if missed == 0 {
+                        break;
+                    }
+                    self.contact_stats.resolves += 1;
+                    if pass == 3 {
+                        report.newton_unconverged = true;
+                    }
+                }
+                report.timings += watch.timings;
+                step_contacts = Some(contacts);
+            }
+        }
+        let mut previous = (s.x.clone(), s.v.clone());
+        let start = s.x.clone();
+        for i in 0..n {
+            s.v[i] = (y[i] - anchor[i]) / h;
+        }
+        if let Some(contacts) = &step_contacts {
+            // A vertex whose rebound was absorbed gets a history of steady motion at its new
+            // velocity, or BDF2's extrapolation from its falling past would lift it again.
+            for i in contacts.absorb_rebound(&y, &mut s.v) {
+                let i = i as usize;
+                previous.0[i] = y[i] - dt * s.v[i];
+                previous.1[i] = s.v[i];
+            }
+        }
+        s.x = y;
+        if let Some(contact) = &model.contact {
+            let mut watch = Stopwatch::start();
+            self.finish_contact(model, contact, &start, s);
+            watch.contact();
+            report.timings += watch.timings;
+        }
+        s.previous = Some(previous);
+        report
+    }
+}
+
+/// What one implicit step minimises over: Φ's inertial target x̃, the anchor x̂ of the
+/// step's velocity, and the effective step h.
+#[derive(Clone, Copy)]
+pub(super) struct ImplicitStep<'a> {
+    pub model: &'a Model,
+    pub h: f64,
+    pub anchor: &'a [DVec3],
+    pub inertial: &'a [DVec3],
+}
+
+impl ImplicitStep<'_> {
+    /// The incremental potential Φ at `y` without contact.
+    pub fn potential(&self, y: &[DVec3]) -> f64 {
+        let (model, h) = (self.model, self.h);
+        let zeta = model.options.damping;
+        let inertia: f64 = (0..y.len())
+            .filter(|&i| !model.fixed[i])
+            .map(|i| {
+                let m = model.mass[i];
+                m / (2.0 * h * h) * (y[i] - self.inertial[i]).length_squared()
+                    + zeta * m / (2.0 * h) * (y[i] - self.anchor[i]).length_squared()
+            })
+            .sum();
+        inertia + model.potential_energy(y)
+    }
+}

@@ -1,0 +1,350 @@
+//! Newton's method on the incremental potential, in its phases: the gradient, the last step
+//! taken from the preconditioner, the forcing term that sets how exactly each linear
+//! system is solved, the solve itself (`preconditioning.rs` decides its factor and how an
+//! indefinite matrix is handled), and the line search.
+
+use super::implicit::ImplicitStep;
+use super::report::{StepReport, Stopwatch};
+use super::Integrator;
+use crate::sim::contact::StepContacts;
+use crate::sim::linalg::{BlockCsr, Coupling, ScalarCsr, SystemMatrix};
+use crate::sim::model::CompressedEdges;
+use glam::DVec3;
+
+/// The share of inertia (m/h² + ζm/h) that compressed edges' negative geometric stiffness
+/// may take in Newton's matrix, which keeps at least 1 − SOFTENING_SHARE of it.
+const SOFTENING_SHARE: f64 = 0.9;
+
+/// The longest step, in Newton steps, that the line search tries along a direction where Φ
+/// is nearly flat.
+const EXTRAPOLATION: f64 = 8.0;
+
+/// What stays fixed through one Newton solve: the step's potential, its contacts and the
+/// constant parts of Newton's matrix.
+pub(super) struct NewtonProblem<'a> {
+    pub step: &'a ImplicitStep<'a>,
+    pub contacts: Option<&'a StepContacts>,
+    /// m/h² + ζm/h per vertex, the inertia in Newton's matrix.
+    pub mass_diagonal: Vec<f64>,
+    /// How much of that each free vertex's compressed edges may take back (the bounded
+    /// matrix, `CompressedEdges::Within`); infinite on fixed vertices.
+    pub softening: Vec<f64>,
+    /// Newton stops at a step shorter than this, m.
+    pub tolerance: f64,
+    /// With nothing fixed and nothing touched, the elastic forces are internal: momentum is
+    /// conserved, and each Newton direction is corrected to keep it so.
+    pub all_free: bool,
+}
+
+impl<'a> NewtonProblem<'a> {
+    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64) -> Self {
+        let ImplicitStep { model, h, .. } = *step;
+        let zeta = model.options.damping;
+        let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
+        // Compressed edges may take back up to this share of each vertex's inertia in
+        // Newton's matrix: it stays positive definite, and Newton converges quadratically
+        // where the cloth buckles unless the compression outweighs inertia.
+        let softening = mass_diagonal.iter().zip(&model.fixed).map(|(&d, &f)| if f { f64::INFINITY } else { SOFTENING_SHARE * d }).collect();
+        let all_free = !model.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
+        Self { step, contacts, mass_diagonal, softening, tolerance: tolerance * model.mean_edge_length, all_free }
+    }
+
+    /// Φ at `y`, contact included.
+    pub fn objective(&self, y: &[DVec3]) -> f64 {
+        self.step.potential(y) + self.contacts.map_or(0.0, |c| c.energy(y, self.step.anchor))
+    }
+
+    /// Assembles the in-plane stiffness at `y` with `compressed` edges, and contact's
+    /// Hessian, into `k`.
+    pub fn assemble(&self, y: &[DVec3], k: &mut BlockCsr, compressed: CompressedEdges) {
+        self.step.model.assemble_membrane_stiffness_within(y, k, compressed);
+        if let Some(c) = self.contacts {
+            c.add_hessian(y, self.step.anchor, k);
+        }
+    }
+}
+
+/// The work arrays of one Newton solve.
+pub(super) struct NewtonWork {
+    /// The exact in-plane stiffness (and contact's Hessian).
+    pub stiffness: BlockCsr,
+    /// The same with compressed edges bounded (`CompressedEdges::Within`).
+    pub bounded: BlockCsr,
+    /// ∇Φ, zero on fixed vertices.
+    pub gradient: Vec<DVec3>,
+    /// −∇Φ, the right-hand side of Newton's system.
+    pub rhs: Vec<DVec3>,
+    pub direction: Vec<DVec3>,
+    pub trial: Vec<DVec3>,
+    /// Cloth–cloth contact's couplings in Newton's matrix.
+    pub couplings: Vec<Coupling>,
+}
+
+/// What one iteration hands the next.
+#[derive(Default)]
+struct NewtonHistory {
+    /// |∇Φ| of the previous iteration.
+    previous_norm: Option<f64>,
+    /// The length of the previous step taken (after the line search).
+    previous_step: Option<f64>,
+    /// The last Newton step's length, if it was taken whole.
+    previous_full_step: Option<f64>,
+    /// Φ at the current iterate, where the line search accepted it.
+    phi_current: Option<f64>,
+    /// This step's solves take the bounded matrix from now on (`solve_direction`).
+    bounded_throughout: bool,
+}
+
+/// How an iteration's line search ended.
+enum Progress {
+    /// The step taken is under Newton's tolerance, or Φ cannot be lowered measurably at
+    /// round-off level: converged.
+    Converged,
+    Continue,
+}
+
+impl Integrator {
+    /// Newton's method on the incremental potential Φ (plus contact), from `y` in place.
+    pub(super) fn newton(&mut self, step: &ImplicitStep, contacts: Option<&StepContacts>, y: &mut Vec<DVec3>, report: &mut StepReport) {
+        let model = step.model;
+        let problem = NewtonProblem::new(step, contacts, self.newton.tolerance);
+        let n = y.len();
+        let mut work = NewtonWork {
+            stiffness: model.stiffness_matrix(),
+            bounded: model.stiffness_matrix(),
+            gradient: vec![DVec3::ZERO; n],
+            rhs: Vec::new(),
+            direction: vec![DVec3::ZERO; n],
+            trial: y.clone(),
+            couplings: Vec::new(),
+        };
+        let mut history = NewtonHistory::default();
+        let mut watch = Stopwatch::start();
+        report.newton_unconverged = true;
+        for _ in 0..self.newton.max_iterations {
+            let norm = self.gradient(&problem, y, &mut work.gradient, &mut watch);
+            work.rhs = work.gradient.iter().map(|g| -*g).collect();
+            if self.last_step_from_preconditioner(&problem, &history, norm, &mut work, y, &mut watch) {
+                report.newton_unconverged = false;
+                break;
+            }
+            let bending = model.bending_newton_matrix(y);
+            let cg_tolerance = self.forcing_tolerance(&history, norm, problem.tolerance);
+            history.previous_norm = Some(norm);
+            self.solve_direction(&problem, &mut work, y, bending.as_deref(), cg_tolerance, &mut history.bounded_throughout, report, &mut watch);
+            if problem.all_free {
+                keep_momentum(&problem.mass_diagonal, &work.gradient, &mut work.direction);
+            }
+            report.newton_iterations += 1;
+            if let Progress::Converged = line_search(&problem, &mut work, &mut history, y, &mut watch) {
+                report.newton_unconverged = false;
+                break;
+            }
+        }
+        report.timings += watch.timings;
+    }
+
+    /// ∇Φ at `y` into `gradient` (zero on fixed vertices), and its norm.
+    fn gradient(&mut self, problem: &NewtonProblem, y: &[DVec3], gradient: &mut [DVec3], watch: &mut Stopwatch) -> f64 {
+        let ImplicitStep { model, h, anchor, inertial } = *problem.step;
+        let zeta = model.options.damping;
+        let n = y.len();
+        self.forces.resize(n, DVec3::ZERO);
+        model.forces(y, &mut self.forces);
+        let forces = &self.forces;
+        for i in 0..n {
+            gradient[i] = if model.fixed[i] {
+                DVec3::ZERO
+            } else {
+                model.mass[i] / (h * h) * (y[i] - inertial[i]) + zeta * model.mass[i] / h * (y[i] - anchor[i]) - forces[i]
+            };
+        }
+        watch.forces();
+        if let Some(c) = problem.contacts {
+            c.add_gradient(y, anchor, gradient, &model.fixed);
+            for (g, &f) in gradient.iter_mut().zip(&model.fixed) {
+                if f {
+                    *g = DVec3::ZERO;
+                }
+            }
+            watch.contact();
+        }
+        gradient.iter().map(|g| g.length_squared()).sum::<f64>().sqrt()
+    }
+
+    /// Newton stops at a step under the tolerance. Where the next step promises to be one,
+    /// it is taken with the last preconditioner instead of being assembled and solved for:
+    /// while Newton converges the step shrinks as the gradient does, so the last full step
+    /// scaled by the gradient's decrease predicts it, and the preconditioner (a factor of a
+    /// recent Newton matrix) gives it to within that factor's error. True if it was taken
+    /// (Newton has converged); otherwise the iteration goes on as usual. On the paper's
+    /// drape a quarter of all Newton iterations had done nothing but take such a step.
+    fn last_step_from_preconditioner(&self, problem: &NewtonProblem, history: &NewtonHistory, norm: f64, work: &mut NewtonWork, y: &mut [DVec3], watch: &mut Stopwatch) -> bool {
+        let (Some(before), Some(full), Some(cached)) = (history.previous_norm, history.previous_full_step, self.preconditioner.as_ref()) else {
+            return false;
+        };
+        if !(cached.size == y.len() && norm < 0.5 * before && full * norm / before < problem.tolerance) {
+            return false;
+        }
+        cached.preconditioner.apply(&work.rhs, &mut work.direction);
+        if problem.all_free {
+            keep_momentum(&problem.mass_diagonal, &work.gradient, &mut work.direction);
+        }
+        let length = work.direction.iter().map(|d| d.length()).fold(0.0, f64::max);
+        watch.solve();
+        if length < problem.tolerance && problem.contacts.is_none_or(|c| c.step_limit(y, &work.direction) >= 1.0) {
+            let fixed = &problem.step.model.fixed;
+            for (i, d) in work.direction.iter().enumerate() {
+                if !fixed[i] {
+                    y[i] += *d;
+                }
+            }
+            return true;
+        }
+        false
+    }
+
+    /// The relative residual to solve this iteration's linear system to.
+    fn forcing_tolerance(&self, history: &NewtonHistory, norm: f64, tolerance: f64) -> f64 {
+        if !self.newton.forcing {
+            return self.newton.cg_tolerance;
+        }
+        // Eisenstat and Walker's safeguard against tightening too fast, 0.9·η²_{k−1},
+        // only acts above 0.1, which this term never exceeds.
+        let eta = history.previous_norm.map_or(0.1, |before| 0.9 * (norm / before).powi(2));
+        // A solve need not be more exact than the tolerance Newton stops at: with
+        // relative residual η the step misses Newton's by about η times its length,
+        // which the last step's length scaled by the gradient's decrease predicts.
+        // Solving to an error of a tenth of the tolerance is enough; tighter solves
+        // of the last, sub-tolerance step cost a third of the drape's CG iterations.
+        let floor = match (history.previous_norm, history.previous_step) {
+            (Some(before), Some(length)) if length > 0.0 && before > 0.0 => 0.1 * tolerance / (length * norm / before),
+            _ => 0.0,
+        };
+        eta.max(floor).clamp(self.newton.cg_tolerance, 0.1)
+    }
+
+    /// Solves Newton's system for `work.direction`.
+    ///
+    /// Newton's matrix takes the exact Hessian of the compressed edges: a buckling cloth's
+    /// softening is what makes Newton converge quadratically. Where it outweighs inertia and
+    /// bending the matrix is indefinite. With the incomplete factor (coarse meshes) CG then
+    /// meets a direction of negative curvature or returns no descent, and the solve is
+    /// repeated with the softening bounded so that the matrix stays positive definite. With a
+    /// global preconditioner (fine meshes) the exact matrix is shifted instead
+    /// (`solve_shifted`).
+    #[allow(clippy::too_many_arguments)]
+    fn solve_direction(
+        &mut self,
+        problem: &NewtonProblem,
+        work: &mut NewtonWork,
+        y: &[DVec3],
+        bending: Option<&ScalarCsr>,
+        cg_tolerance: f64,
+        bounded_throughout: &mut bool,
+        report: &mut StepReport,
+        watch: &mut Stopwatch,
+    ) {
+        if let Some(c) = problem.contacts {
+            work.couplings.clear();
+            c.couplings(y, &mut work.couplings);
+            watch.contact();
+        }
+        problem.assemble(y, &mut work.stiffness, CompressedEdges::Exact);
+        watch.forces();
+        let model = problem.step.model;
+        let system = SystemMatrix { mass_diagonal: &problem.mass_diagonal, stiffness: &work.stiffness, bending, fixed: &model.fixed, couplings: &work.couplings };
+        if self.newton.preconditioner.global(y.len()).is_some() {
+            self.solve_global(problem, &system, &mut work.bounded, y, &work.rhs, &mut work.direction, cg_tolerance, bounded_throughout, report, watch);
+        } else {
+            self.solve_incomplete(problem, &system, &mut work.bounded, y, &work.gradient, &work.rhs, &mut work.direction, cg_tolerance, report, watch);
+        }
+    }
+}
+
+/// Backtracking line search on Φ along `work.direction` (with a steepest-descent fallback
+/// where the solve gave no descent), extended past a full step where Φ is flatter than the
+/// matrix says; moves `y` to the accepted point.
+fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut NewtonHistory, y: &mut Vec<DVec3>, watch: &mut Stopwatch) -> Progress {
+    let model = problem.step.model;
+    let n = y.len();
+    let (gradient, direction) = (&work.gradient, &mut work.direction);
+    let slope: f64 = gradient.iter().zip(direction.iter()).map(|(g, d)| g.dot(*d)).sum();
+    if slope >= 0.0 {
+        // Not a descent direction (the CG broke down): fall back to steepest descent
+        // scaled by the mass term.
+        for i in 0..n {
+            direction[i] = if model.fixed[i] { DVec3::ZERO } else { -gradient[i] / problem.mass_diagonal[i] };
+        }
+    }
+    let slope: f64 = gradient.iter().zip(direction.iter()).map(|(g, d)| g.dot(*d)).sum();
+    // Φ at the current iterate is the previous iteration's accepted trial value.
+    let phi0 = *history.phi_current.get_or_insert_with(|| problem.objective(y));
+    let limit = problem.contacts.map_or(f64::INFINITY, |c| c.step_limit(y, direction));
+    let mut alpha = limit.min(1.0);
+    let mut accepted = false;
+    let mut phi = phi0;
+    let trial = &mut work.trial;
+    for _ in 0..30 {
+        for i in 0..n {
+            trial[i] = y[i] + alpha * direction[i];
+        }
+        phi = problem.objective(trial);
+        if phi.is_finite() && phi <= phi0 + 1e-4 * alpha * slope {
+            accepted = true;
+            break;
+        }
+        alpha *= 0.5;
+    }
+    let length = direction.iter().map(|d| d.length()).fold(0.0, f64::max);
+    if accepted && alpha == 1.0 && length > 10.0 * problem.tolerance {
+        // Where Φ is flatter along d than the matrix says, a full step is accepted yet falls
+        // short of the minimum along d. The parabola through Φ(0), Φ'(0) and Φ(1) places that
+        // minimum; a step towards it (at most EXTRAPOLATION times the full step, short of any
+        // cloth–cloth pair and of a tenth of an edge per vertex) is kept if Φ is lower there.
+        // On a quadratic Φ with Newton's direction the parabola's minimum is at 1 and nothing
+        // is tried. It fires where Newton creeps in steps of a few µm on fine meshes, and
+        // never on the coarse scenes.
+        let curvature = 2.0 * (phi - phi0 - slope);
+        let best = if curvature > 0.0 { -slope / curvature } else { f64::INFINITY };
+        let reach = 0.1 * model.mean_edge_length / length;
+        let target = best.min(EXTRAPOLATION).min(0.9 * limit).min(reach);
+        if target > 1.5 {
+            let further: Vec<DVec3> = (0..n).map(|i| y[i] + target * direction[i]).collect();
+            let phi_further = problem.objective(&further);
+            if phi_further < phi {
+                alpha = target;
+                phi = phi_further;
+                *trial = further;
+            }
+        }
+    }
+    history.phi_current = Some(phi).filter(|_| accepted);
+    watch.forces();
+    let step_size = alpha * length;
+    history.previous_step = Some(step_size);
+    history.previous_full_step = Some(length).filter(|_| accepted && alpha == 1.0);
+    if !accepted {
+        // Φ cannot be decreased measurably: at round-off level we are converged; otherwise
+        // take the smallest tried step and let the iteration limit speak.
+        if step_size < 10.0 * problem.tolerance {
+            return Progress::Converged;
+        }
+    }
+    std::mem::swap(y, trial);
+    if step_size < problem.tolerance { Progress::Converged } else { Progress::Continue }
+}
+
+/// With nothing fixed and nothing touched, corrects a Newton direction d so that momentum
+/// is conserved to round-off whatever the solve's error. The elastic Hessian annihilates
+/// translations, so adding a constant c to d changes only the mass term of H d; choosing c
+/// so that Σ M (d + c) = −Σ g removes the net force the residual would leave.
+fn keep_momentum(mass_diagonal: &[f64], gradient: &[DVec3], direction: &mut [DVec3]) {
+    let (mut mass_sum, mut residual) = (0.0, DVec3::ZERO);
+    for ((&m, &g), &d) in mass_diagonal.iter().zip(gradient).zip(direction.iter()) {
+        mass_sum += m;
+        residual += g + m * d;
+    }
+    let shift = -residual / mass_sum;
+    direction.iter_mut().for_each(|d| *d += shift);
+}

@@ -1,0 +1,105 @@
+//! What a step reports: its cost, and why it was rejected.
+
+use super::IntegratorKind;
+use serde::Serialize;
+use std::time::Instant;
+use thiserror::Error;
+
+/// Why a step was rejected.
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum StepError {
+    #[error(
+        "the simulation diverged with {integrator} at dt = {dt:e} s (t = {time:.6} s): {reason}. \
+         The last good state is kept. Use a smaller solver.dt or an implicit integrator \
+         (solver.integrator = \"implicit-euler\")"
+    )]
+    Diverged { integrator: IntegratorKind, dt: f64, time: f64, reason: String },
+}
+
+/// What one step cost.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepReport {
+    pub newton_iterations: usize,
+    pub cg_iterations: usize,
+    /// Preconditioners built (factorisations, complete or incomplete; failed ones included).
+    pub factorizations: usize,
+    /// True when Newton stopped at its iteration limit before reaching its tolerance.
+    pub newton_unconverged: bool,
+    /// Where the step's time went.
+    pub timings: StepTimings,
+    /// The time step taken, s.
+    pub dt: f64,
+    /// Attempts thrown away by the adaptive step control before this one stood.
+    pub rejected: usize,
+    /// The largest shift Newton's matrix took to stay positive definite, as a share of the
+    /// inertia (meshes with a complete factor; `Integrator::solve_shifted`).
+    pub shift: f64,
+}
+
+impl StepReport {
+    /// Adds another attempt's work (iterations and time).
+    pub(super) fn add_work(&mut self, other: &StepReport) {
+        self.newton_iterations += other.newton_iterations;
+        self.cg_iterations += other.cg_iterations;
+        self.factorizations += other.factorizations;
+        self.timings += other.timings;
+        self.shift = self.shift.max(other.shift);
+    }
+}
+
+/// Wall-clock seconds of one step (or a sum of steps) by phase, on the calling thread.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct StepTimings {
+    /// Elastic forces and energies (line search included) and Hessian assembly.
+    pub forces: f64,
+    /// The linear solves (preconditioner set-up and conjugate gradient).
+    pub solve: f64,
+    /// Collision detection and response: planes, cloth–cloth pairs, CCD, contact forces
+    /// and Hessians, the self-crossing fail-safe.
+    pub contact: f64,
+}
+
+impl std::ops::AddAssign for StepTimings {
+    fn add_assign(&mut self, o: Self) {
+        self.forces += o.forces;
+        self.solve += o.solve;
+        self.contact += o.contact;
+    }
+}
+
+/// Charges the wall time since its last lap to one phase of a step.
+pub(super) struct Stopwatch {
+    clock: Instant,
+    pub timings: StepTimings,
+}
+
+impl Stopwatch {
+    pub fn start() -> Self {
+        Self { clock: Instant::now(), timings: StepTimings::default() }
+    }
+
+    /// Seconds since the last lap (or the start), restarting the clock.
+    fn lap(&mut self) -> f64 {
+        let now = Instant::now();
+        let seconds = (now - self.clock).as_secs_f64();
+        self.clock = now;
+        seconds
+    }
+
+    /// Restarts the clock without charging the time since the last lap to any phase.
+    pub fn restart(&mut self) {
+        self.clock = Instant::now();
+    }
+
+    pub fn forces(&mut self) {
+        self.timings.forces += self.lap();
+    }
+
+    pub fn solve(&mut self) {
+        self.timings.solve += self.lap();
+    }
+
+    pub fn contact(&mut self) {
+        self.timings.contact += self.lap();
+    }
+}

@@ -1,0 +1,124 @@
+//! What the user sets: Newton's tolerances, the preconditioner, adaptive steps.
+
+use serde::{Deserialize, Serialize};
+
+/// Newton and conjugate-gradient settings of the implicit integrators.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NewtonSettings {
+    /// Maximum Newton iterations per step.
+    pub max_iterations: usize,
+    /// Newton stops when no vertex moves more than this fraction of the mean edge length.
+    pub tolerance: f64,
+    /// Relative residual at which the conjugate gradient stops.
+    pub cg_tolerance: f64,
+    /// Maximum conjugate-gradient iterations per Newton iteration.
+    pub cg_max_iterations: usize,
+    /// Inexact Newton (Eisenstat and Walker's second forcing term): early iterations, far
+    /// from the solution, solve their linear systems only to η_k = 0.9(|g_k|/|g_{k−1}|)²
+    /// (at most 0.1, at least `cg_tolerance`) instead of `cg_tolerance`.
+    pub forcing: bool,
+    /// Newton starts from x_n + Δt(2v_n − v_{n−1}), where the last step's acceleration would
+    /// carry the cloth, when Φ is lower there than at the inertial guess (the solution is
+    /// the same to the Newton tolerance; only the start moves closer to it when the motion
+    /// is smooth). Off by default: it saves 18–20 % of the Newton iterations on the drape,
+    /// Euler buckling and the cantilever but costs 46 % more in shear buckling, and on the
+    /// drape its tolerance-sized differences, amplified by the choice of folds, took the
+    /// scatter of three seeds from 0.040 to 0.054 (README, Speed).
+    pub warm_start: bool,
+    /// The conjugate gradient's preconditioner.
+    pub preconditioner: PreconditionerChoice,
+}
+
+/// Which factor preconditions the Newton systems' conjugate gradient.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum PreconditionerChoice {
+    /// The complete factor from `AUTO_CHOLESKY_VERTICES` vertices up, the incomplete one below.
+    #[default]
+    Auto,
+    /// Block incomplete LDLᵀ on the matrix's pattern: cheap to build, and enough on coarse
+    /// meshes, where the bending modes it misses are few.
+    IncompleteCholesky,
+    /// Sparse Cholesky (faer, with a fill-reducing ordering): more memory and a costlier
+    /// build, but CG iterations that stay at a few per Newton iteration at any mesh size.
+    Cholesky,
+    /// Smoothed-aggregation multigrid with the rigid modes as coarse spaces (`multigrid`):
+    /// a cycle whose cost grows linearly with the mesh, but CG iterations that grow too;
+    /// slower than the complete factor at every drape size measured, so `Auto` never takes
+    /// it.
+    Multigrid,
+}
+
+/// The global preconditioners, solved for with the exact matrix shifted where it is
+/// indefinite (`Integrator::solve_shifted`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum GlobalPreconditioner {
+    Cholesky,
+    Multigrid,
+}
+
+impl PreconditionerChoice {
+    /// From this many vertices `Auto` takes the complete factor. Measured (CPU seconds per
+    /// simulated second, incomplete against complete): the Cusick drape's first two steps,
+    /// 2.0 and 2.7 at 475 vertices, 31 and 26 at 2737, 498 and 135 at 10 412; its first
+    /// 0.1 s at 5153 vertices, 83 and 40; the whole `tablecloth` run (1681 vertices, much
+    /// contact), 23 and 97.
+    pub const AUTO_CHOLESKY_VERTICES: usize = 3000;
+
+    /// The global preconditioner for a mesh of `vertices`, or None for the incomplete factor.
+    pub(super) fn global(self, vertices: usize) -> Option<GlobalPreconditioner> {
+        match self {
+            Self::Auto => (vertices >= Self::AUTO_CHOLESKY_VERTICES).then_some(GlobalPreconditioner::Cholesky),
+            Self::IncompleteCholesky => None,
+            Self::Cholesky => Some(GlobalPreconditioner::Cholesky),
+            Self::Multigrid => Some(GlobalPreconditioner::Multigrid),
+        }
+    }
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        Self { max_iterations: 30, tolerance: 1e-5, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true, warm_start: false, preconditioner: PreconditionerChoice::Auto }
+    }
+}
+
+/// Adaptive time steps for the implicit integrators: each step's local position error is
+/// estimated and the next Δt chosen to keep it near `tolerance`; a step whose error is more
+/// than twice that, or whose Newton solve did not converge, is taken again with a smaller Δt.
+///
+/// Implicit Euler's position after one step is x_n + h v_n + h² a_{n+1} where the exact
+/// motion gives x_n + h v_n + ½h² a: the local error is ½h²|a| = ½h|v_{n+1} − v_n|, largest
+/// where the cloth accelerates (a fall, a buckling snap) and vanishing when it moves
+/// steadily or rests. Δt then grows as h ∝ √(tolerance/|a|). For BDF2 the same estimate is
+/// conservative (its error is third order); its two-step history is restarted whenever Δt
+/// changes, as its fixed-step formula requires.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AdaptiveStep {
+    /// Off: Δt stays at `solver.dt` (so that a preset's adaptive section can be switched off
+    /// from the command line).
+    pub enabled: bool,
+    /// Largest local position error per step, m.
+    pub tolerance: f64,
+    /// Smallest and largest Δt, s.
+    pub dt_min: f64,
+    pub dt_max: f64,
+}
+
+impl Default for AdaptiveStep {
+    fn default() -> Self {
+        Self { enabled: true, tolerance: 1e-4, dt_min: 1e-5, dt_max: 0.02 }
+    }
+}
+
+impl AdaptiveStep {
+    /// The factor by which Δt should change after a step whose error estimate was `error`.
+    pub(super) fn factor(&self, error: f64) -> f64 {
+        if error <= 0.0 {
+            return 1.5;
+        }
+        (0.9 * (self.tolerance / error).sqrt()).clamp(0.25, 1.5)
+    }
+}
+
