@@ -74,7 +74,7 @@ fn cases(quick: bool) -> Vec<Case> {
     // The same window for every size, so that their costs compare: the first two 4 ms
     // steps of the lowering (gravity ramps up over 2 s), short enough for 80 000 triangles
     // to finish in minutes. Whole runs to settling cost more per simulated second than
-    // this start (README, Speed).
+    // this start (docs/solvers.md, Benchmarks).
     let sizes: &[(f64, f64)] =
         if quick { &[(800.0, 0.008), (5000.0, 0.008)] } else { &[(800.0, 0.008), (5000.0, 0.008), (20000.0, 0.008), (80000.0, 0.008)] };
     // Each size with the complete factor and with multigrid, side by side.

@@ -2,7 +2,8 @@
 //!
 //! Everything here is textbook mechanics computed from scratch in `f64` with nothing but
 //! `std`, so that a test compares the simulator against physics rather than against
-//! itself. The sources are listed in `shared/REFERENCE.md` (sections 1, 4, 5, 6 and 7).
+//! itself. The sources, formulas and check values are in `docs/references.md` (§1, §4, §5,
+//! §6 and §7).
 //!
 //! Units: SI, per unit width as textile laboratories report fabric properties. Tensile
 //! moduli, shear modulus and load per width in N/m; bending rigidity B in N·m (N·m²/m);
@@ -77,7 +78,7 @@ fn bisect_to_machine_precision(low: f64, high: f64, classify: impl Fn(f64) -> Sh
 }
 
 // ---------------------------------------------------------------------------------------
-// Heavy cantilever (REFERENCE §4; Peirce 1930, ASTM D1388, BS 3356)
+// Heavy cantilever (docs/references.md §4; Peirce 1930, ASTM D1388, BS 3356)
 // ---------------------------------------------------------------------------------------
 
 /// Number of RK4 steps used along the cantilever by [`heavy_cantilever`]. Quartering
@@ -341,7 +342,7 @@ pub fn ellip_e(k: f64) -> f64 {
 }
 
 // ---------------------------------------------------------------------------------------
-// Euler buckling and the post-buckling elastica (REFERENCE §5)
+// Euler buckling and the post-buckling elastica (docs/references.md §5)
 // ---------------------------------------------------------------------------------------
 
 /// Critical compressive load per unit width of a pinned–pinned strip, P_cr = π²·B/L²
@@ -508,7 +509,7 @@ pub fn euler_elastica_shooting(shortening_over_l: f64) -> EulerElastica {
 }
 
 // ---------------------------------------------------------------------------------------
-// Orthotropic plane stress (REFERENCE §1; paper eq. 1–3)
+// Orthotropic plane stress (docs/references.md §1; paper eq. 1–3)
 // ---------------------------------------------------------------------------------------
 
 /// In-plane compliance of an orthotropic sheet rotated by θ: returns (S'₁₁, S'₁₂), the
@@ -561,7 +562,7 @@ pub fn bending_rigidity_theta(bx: f64, by: f64, mid: f64, theta_rad: f64) -> f64
 }
 
 // ---------------------------------------------------------------------------------------
-// Shear of a sheet between a clamped and a sliding edge (REFERENCE §6)
+// Shear of a sheet between a clamped and a sliding edge (docs/references.md §6)
 // ---------------------------------------------------------------------------------------
 
 /// Angle (degrees, from the clamped edge) of the major principal stretch of a simple
@@ -585,7 +586,7 @@ pub fn simple_shear_principal_tension_angle_deg(gamma_rad: f64) -> f64 {
 /// Angle (degrees, from the clamped edge, in the deformed sheet) of the major principal
 /// Cauchy stress of the same simple shear F = [[1, tan γ], [0, 1]] (x = warp along the
 /// clamped edge, y = weft across the gap), for an orthotropic Saint-Venant–Kirchhoff sheet
-/// with the plane-stress moduli of REFERENCE §1 (N/m, or all in Pa).
+/// with the plane-stress moduli of docs/references.md §1 (N/m, or all in Pa).
 ///
 /// Green strain E = ½(FᵀF − I) = [[0, t/2], [t/2, t²/2]]; material-axis stress
 /// S_xx = Q₁₁E_xx + Q₁₂E_yy, S_yy = Q₁₂E_xx + Q₂₂E_yy, S_xy = G·2E_xy with
@@ -622,7 +623,7 @@ pub fn simple_shear_principal_stress_angle_deg(
 }
 
 // ---------------------------------------------------------------------------------------
-// Cusick drape test (REFERENCE §7; BS 5058, ISO 9073-9)
+// Cusick drape test (docs/references.md §7; BS 5058, ISO 9073-9)
 // ---------------------------------------------------------------------------------------
 
 fn disk_area(diameter: f64) -> f64 {
@@ -643,7 +644,7 @@ pub fn cusick_drape_coefficient(
 }
 
 /// Lower bound of the Cusick drape coefficient from independent radial strips: each
-/// strip of the overhang L = (D − d)/2 bends as a heavy cantilever (REFERENCE §4) with
+/// strip of the overhang L = (D − d)/2 bends as a heavy cantilever (docs/references.md §4) with
 /// λ = w·L³/B, w = ρ_A·g, so its tip reaches r = d/2 + (x_tip/L)·L and the shadow is the
 /// disk of radius r: DC = (π·r² − A_disk)/(A_specimen − A_disk).
 ///

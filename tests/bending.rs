@@ -1,5 +1,6 @@
-//! Bending validation: the arc under end moments (κ = m/B_θ, REFERENCE §3) and the heavy
-//! cantilever against the elastica (REFERENCE §4), over warp angles and triangulations.
+//! Bending validation: the arc under end moments (κ = m/B_θ, docs/references.md §3) and the
+//! heavy cantilever against the elastica (docs/references.md §4), over warp angles and
+//! triangulations.
 
 mod common;
 
@@ -152,13 +153,15 @@ fn cantilever_is_independent_of_the_warp_angle_for_isotropic_bending() {
 /// Open question, reported on the issue: a narrow wool strip cut on the bias is mostly free
 /// edge. Eq. 3's B_θ is a plate (wide-specimen) rigidity, which `arc_rigidity_off_axis_…`
 /// confirms, but a strip half as wide as it is long relaxes by anticlastic bending and
-/// twist (D'12 and D'16 are large on the bias), so at λ = 1 it droops 28 % more than the
-/// elastica with B_45 predicts; its rigidity lies between D'11 and the free-strip 1/d'11.
-/// Whether a fabric's `bending_bias` should be read as a strip or a plate property decides
-/// what this test should expect; it stays at the issue's 2 % until that is settled.
+/// twist (D'12 and D'16 are large on the bias), so it droops more than the elastica with
+/// B_45 predicts (docs/model.md, Measured accuracy); its rigidity lies between D'11 and the
+/// free-strip 1/d'11 (docs/references.md §8 on free bias strips). Whether a fabric's
+/// `bending_bias` should be read as a strip or a plate property decides what this test
+/// should expect; it asks for the plate's B_θ within the issue's 2 % and stays ignored
+/// until that is settled.
 #[test]
 #[ignore = "narrow wool bias strip: 28 % more droop than eq. 3's B_45 at λ = 1 (anticlastic + twist); open, see the issue note"]
-fn cantilever_follows_b_theta_on_the_bias() {
+fn narrow_bias_strip_against_plate_b_theta_is_an_open_question() {
     cantilever_check(&["alternating"], &[45.0], &[]);
 }
 

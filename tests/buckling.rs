@@ -1,5 +1,5 @@
 //! Buckling validation: Euler buckling between pinned ends against π²B/L² and the
-//! elastica (REFERENCE §5), and wrinkling in shear against the tension field (§6).
+//! elastica (docs/references.md §5), and wrinkling in shear against the tension field (§6).
 
 mod common;
 

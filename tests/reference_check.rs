@@ -1,5 +1,5 @@
 //! Checks of the physics reference solutions in `tests/common/reference.rs` against the
-//! values quoted in `shared/REFERENCE.md`, known limits and second, independent methods,
+//! values quoted in `docs/references.md`, known limits and second, independent methods,
 //! so that the validation tests built on them compare the simulator with trusted numbers.
 
 mod common;
@@ -27,7 +27,7 @@ fn printed_precision(decimals: i32) -> f64 {
 
 #[test]
 fn heavy_cantilever_matches_reference_sanity_values() {
-    // (λ, tip drop / L, tip angle in degrees), REFERENCE §4.
+    // (λ, tip drop / L, tip angle in degrees), docs/references.md §4.
     let quoted = [
         (2.0, 0.2385, 18.4),
         (8.0, 0.6406, 53.9),
@@ -53,7 +53,7 @@ fn heavy_cantilever_matches_reference_sanity_values() {
 #[test]
 fn heavy_cantilever_chord_reaches_overhang_test_angle_at_twice_the_bending_length() {
     // ASTM D1388 reads the bending length where the chord makes 41.5° (L = 2c, λ = 8);
-    // REFERENCE §4 quotes the exact elastica chord angle there as 41.49°.
+    // docs/references.md §4 quotes the exact elastica chord angle there as 41.49°.
     let solution = heavy_cantilever(8.0);
     assert_close(
         "chord angle at λ = 8",
@@ -285,7 +285,7 @@ fn euler_critical_load_is_pi_squared_b_over_l_squared() {
 
 #[test]
 fn euler_elastica_matches_reference_sanity_values() {
-    // (Δ/L, δ/L, P/P_cr), REFERENCE §5.
+    // (Δ/L, δ/L, P/P_cr), docs/references.md §5.
     for (shortening, deflection, load) in [(0.05, 0.1401, 1.0257), (0.20, 0.2663, 1.1127)] {
         let elastica = euler_elastica_from_shortening(shortening);
         assert_close(
@@ -415,7 +415,7 @@ fn off_axis_modulus_recovers_material_axes_and_bias_identity() {
         |theta: f64| off_axis_modulus(FABRIC_EX, FABRIC_EY, FABRIC_G, FABRIC_NU_XY, theta);
     assert_close("E at 0°", modulus(0.0), FABRIC_EX, 1e-12 * FABRIC_EX);
     assert_close("E at 90°", modulus(FRAC_PI_2), FABRIC_EY, 1e-12 * FABRIC_EY);
-    // REFERENCE §1: at 45°, 1/G = 4/E₄₅ − (1 − 2ν_xy)/E_x − 1/E_y.
+    // docs/references.md §1: at 45°, 1/G = 4/E₄₅ − (1 − 2ν_xy)/E_x − 1/E_y.
     let bias = modulus(FRAC_PI_4);
     let shear_compliance = 4.0 / bias - (1.0 - 2.0 * FABRIC_NU_XY) / FABRIC_EX - 1.0 / FABRIC_EY;
     assert_close(

@@ -1,4 +1,4 @@
-//! Validates the tensile rig against REFERENCE.md §1–2: a quasi-static strip pull must
+//! Validates the tensile rig against docs/references.md §1–2: a quasi-static strip pull must
 //! reproduce the fabric's input stress–strain curve (warp, weft, a many-kneed curve, every
 //! integrator), a warp pull must contract laterally by ν_xy, and a bias pull must follow the
 //! orthotropic off-axis modulus and Poisson ratio.
@@ -219,7 +219,7 @@ fn warp_pull_poisson_ratio_is_the_input_nu_xy() {
 }
 
 // ---------------------------------------------------------------------------------------
-// Bias pull: off-axis modulus and Poisson ratio (REFERENCE §1)
+// Bias pull: off-axis modulus and Poisson ratio (docs/references.md §1)
 // ---------------------------------------------------------------------------------------
 
 /// Least-squares slope through the origin of the points above `MIN_STRAIN`.

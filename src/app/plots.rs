@@ -263,7 +263,8 @@ mod tests {
 
     #[test]
     fn elastica_starts_at_the_euler_load_with_slope_one_half() {
-        // Post-buckling: P/P_cr ≈ 1 + Δ/(2L) for small Δ/L; 1.0530 at Δ/L = 10 % (README).
+        // Post-buckling: P/P_cr ≈ 1 + Δ/(2L) for small Δ/L; 1.0530 at Δ/L = 10 %
+        // (docs/references.md §5).
         let curve = elastica(0.2);
         let near = |s: f64| curve.iter().min_by(|a, b| (a[0] - s).abs().total_cmp(&(b[0] - s).abs())).unwrap();
         let small = near(0.005);

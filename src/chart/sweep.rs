@@ -20,12 +20,13 @@ const TENSILE_MIN_STRAIN: f64 = 0.002;
 /// The problems with known answers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Problem {
-    /// ASTM D1388 cantilever: tip drop against the heavy elastica (REFERENCE §4).
+    /// ASTM D1388 cantilever: tip drop against the heavy elastica (docs/references.md §4).
     Cantilever,
     /// Pinned strip compressed 10 %: midspan deflection against the Euler elastica at the
-    /// run's end-shortening (REFERENCE §5).
+    /// run's end-shortening (docs/references.md §5).
     Buckling,
-    /// Warp strip pull: worst relative stress error against the input curve (REFERENCE §1).
+    /// Warp strip pull: worst relative stress error against the input curve
+    /// (docs/references.md §1).
     Tensile,
     /// Cusick drape, 30 cm specimen: drape coefficient against a fine-mesh run.
     Drape,

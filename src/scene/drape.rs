@@ -1,6 +1,6 @@
-//! Drape measurements (BS 5058 / ISO 9073-9, REFERENCE §7): the shadow of the draped cloth
-//! on the horizontal plane, its area, its outline in polar form, the drape coefficient and
-//! the number of folds (nodes).
+//! Drape measurements (BS 5058 / ISO 9073-9, docs/references.md §7): the shadow of the
+//! draped cloth on the horizontal plane, its area, its outline in polar form, the drape
+//! coefficient and the number of folds (nodes).
 
 use glam::{DVec2, DVec3};
 
