@@ -529,42 +529,6 @@ fn save_screenshot(
     });
     let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
     encode_frame(gpu, &view, jobs, screen, snapshot, ui);
-    let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("screenshot readback"),
-        size: u64::from(row) * u64::from(height),
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("screenshot copy") });
-    encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(height) },
-        },
-        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-    );
-    gpu.queue.submit([encoder.finish()]);
-    let slice = buffer.slice(..);
-    let (tx, rx) = channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| drop(tx.send(r)));
-    gpu.device.poll(wgpu::PollType::wait_indefinitely()).context("waiting for the GPU")?;
-    rx.recv().context("the readback was dropped")?.context("cannot map the readback buffer")?;
-    let data = slice.get_mapped_range().context("cannot read the readback buffer")?;
-    let bgra = matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
-    let mut rgba = Vec::with_capacity((width * height * 4) as usize);
-    for y in 0..height as usize {
-        for pixel in data[y * row as usize..][..width as usize * 4].chunks_exact(4) {
-            let [a, b, c, alpha] = [pixel[0], pixel[1], pixel[2], pixel[3]];
-            rgba.extend_from_slice(&if bgra { [c, b, a, alpha] } else { [a, b, c, alpha] });
-            let _ = alpha;
-        }
-    }
-    drop(data);
-    buffer.unmap();
-    for alpha in rgba.iter_mut().skip(3).step_by(4) {
-        *alpha = 255;
-    }
-    image::save_buffer(path, &rgba, width, height, image::ExtendedColorType::Rgba8).with_context(|| format!("cannot write {}", path.display()))
+    let image = render::read_back(&gpu.device, &gpu.queue, &texture)?;
+    image.save(path).with_context(|| format!("cannot write {}", path.display()))
 }

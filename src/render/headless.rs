@@ -66,43 +66,62 @@ impl Headless {
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         self.renderer.prepare(&self.device, &self.queue, frame, camera, options, size);
-        // Rows of a texture-to-buffer copy are padded to 256 bytes.
-        let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("rosette readback"),
-            size: u64::from(row) * u64::from(height),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("rosette headless frame") });
         self.renderer.render(&mut encoder, &view);
-        encoder.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(height) },
-            },
-            extent,
-        );
         self.queue.submit([encoder.finish()]);
-        let slice = buffer.slice(..);
-        let (tx, rx) = channel();
-        slice.map_async(wgpu::MapMode::Read, move |result| drop(tx.send(result)));
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Readback(e.to_string()))?;
-        rx.recv().map_err(|e| RenderError::Readback(e.to_string()))?.map_err(|e| RenderError::Readback(e.to_string()))?;
-        let data = slice.get_mapped_range().map_err(|e| RenderError::Readback(e.to_string()))?;
-        let mut pixels = Vec::with_capacity((width * height * 4) as usize);
-        for y in 0..height as usize {
-            pixels.extend_from_slice(&data[y * row as usize..][..width as usize * 4]);
-        }
-        drop(data);
-        buffer.unmap();
-        // The picture is opaque whatever the blending left in alpha.
-        for alpha in pixels.iter_mut().skip(3).step_by(4) {
-            *alpha = 255;
-        }
-        Ok(image::RgbaImage::from_raw(width, height, pixels).expect("width × height × 4 bytes"))
+        read_back(&self.device, &self.queue, &texture)
     }
+}
+
+/// Copies a rendered texture back from the GPU as an opaque RGBA image: the headless
+/// screenshots and the viewer's Screenshot button both read their frames this way. The
+/// texture needs `COPY_SRC` usage and an 8-bit RGBA or BGRA format (sRGB or not: the
+/// bytes are taken as they are stored); BGRA pixels are reordered to RGBA.
+pub fn read_back(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Result<image::RgbaImage, RenderError> {
+    let (width, height) = (texture.width(), texture.height());
+    let bgra = match texture.format() {
+        wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb => true,
+        wgpu::TextureFormat::Rgba8Unorm | wgpu::TextureFormat::Rgba8UnormSrgb => false,
+        other => return Err(RenderError::Readback(format!("cannot read back a {other:?} texture as RGBA"))),
+    };
+    // Rows of a texture-to-buffer copy are padded to 256 bytes.
+    let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("rosette readback"),
+        size: u64::from(row) * u64::from(height),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("rosette readback copy") });
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(height) },
+        },
+        texture.size(),
+    );
+    queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    let (tx, rx) = channel();
+    slice.map_async(wgpu::MapMode::Read, move |result| drop(tx.send(result)));
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Readback(e.to_string()))?;
+    rx.recv().map_err(|e| RenderError::Readback(e.to_string()))?.map_err(|e| RenderError::Readback(e.to_string()))?;
+    let data = slice.get_mapped_range().map_err(|e| RenderError::Readback(e.to_string()))?;
+    let mut pixels = Vec::with_capacity((width * height * 4) as usize);
+    for y in 0..height as usize {
+        pixels.extend_from_slice(&data[y * row as usize..][..width as usize * 4]);
+    }
+    drop(data);
+    buffer.unmap();
+    for pixel in pixels.chunks_exact_mut(4) {
+        if bgra {
+            pixel.swap(0, 2);
+        }
+        // The picture is opaque whatever the blending left in alpha.
+        pixel[3] = 255;
+    }
+    Ok(image::RgbaImage::from_raw(width, height, pixels).expect("width × height × 4 bytes"))
 }
 
 /// What `rosette run --screenshot` draws and where it writes it.

@@ -18,6 +18,8 @@
 //!                 target: &wgpu::TextureView)          // clears, owns depth and MSAA targets
 //! renderer.paint(&self, pass: &mut wgpu::RenderPass<'_>)  // into the caller's pass
 //! Headless::new() -> Result<Headless, RenderError>
+//! read_back(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture)
+//!     -> Result<image::RgbaImage, RenderError>                 // the viewer's screenshots too
 //! headless.render(&mut self, frame: &Frame, camera: &Camera, options: &RenderOptions,
 //!                 size: [u32; 2]) -> Result<image::RgbaImage, RenderError>
 //! save_screenshot(scene: &Scene, options: &Screenshot) -> Result<(), RenderError>
@@ -59,7 +61,7 @@ mod renderer;
 pub use camera::Camera;
 pub use colormap::{ColorMap, ScalarField};
 pub use frame::{Frame, PropMesh};
-pub use headless::{Headless, Screenshot, save_screenshot};
+pub use headless::{Headless, Screenshot, read_back, save_screenshot};
 pub use legend::bar_rect as legend_bar_rect;
 pub use renderer::{DEPTH_FORMAT, Renderer};
 
