@@ -7,6 +7,7 @@
 //! growth between the smallest and the largest drape, per vertex added) and the wall-clock
 //! speed-up from one thread to two.
 
+use crate::scene::Metrics;
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use std::io::Write;
@@ -109,32 +110,27 @@ fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
     if !output.status.success() {
         bail!("{}: rosette run failed: {}", case.name, String::from_utf8_lossy(&output.stderr).trim());
     }
-    let m: serde_json::Value = serde_json::from_slice(&output.stdout).context("reading the run's metrics")?;
-    let f = |key: &str| m[key].as_f64().unwrap_or(f64::NAN);
-    let split = &m["step_time"];
-    let (forces, solve, contact) =
-        (split["forces"].as_f64().unwrap_or(0.0), split["solve"].as_f64().unwrap_or(0.0), split["contact"].as_f64().unwrap_or(0.0));
+    let m: Metrics = serde_json::from_slice(&output.stdout).with_context(|| format!("{}: reading the run's metrics", case.name))?;
+    let (forces, solve, contact) = (m.step_time.forces, m.step_time.solve, m.step_time.contact);
     let total = (forces + solve + contact).max(f64::MIN_POSITIVE);
-    let steps = m["steps"].as_u64().unwrap_or(0);
-    let newton = f("newton_iterations");
-    let simulated = f("simulated_seconds");
+    let newton = m.newton_iterations as f64;
     Ok(BenchRow {
         case: case.name.clone(),
         threads,
-        triangles: m["triangles"].as_u64().unwrap_or(0),
-        vertices: m["vertices"].as_u64().unwrap_or(0),
-        steps,
-        simulated_seconds: simulated,
-        wall_seconds: f("wall_seconds"),
-        cpu_seconds_per_simulated_second: f("cpu_seconds_per_simulated_second"),
-        wall_seconds_per_simulated_second: f("wall_seconds") / simulated,
+        triangles: m.triangles as u64,
+        vertices: m.vertices as u64,
+        steps: m.steps,
+        simulated_seconds: m.simulated_seconds,
+        wall_seconds: m.wall_seconds,
+        cpu_seconds_per_simulated_second: m.cpu_seconds_per_simulated_second,
+        wall_seconds_per_simulated_second: m.wall_seconds / m.simulated_seconds,
         forces_share: forces / total,
         solve_share: solve / total,
         contact_share: contact / total,
         solver_speedup_bound: (forces + contact > 0.0).then(|| total / (forces + contact)),
-        newton_per_step: newton / steps.max(1) as f64,
-        cg_per_newton: f("cg_iterations") / newton.max(1.0),
-        peak_memory_mb: m["peak_memory_bytes"].as_f64().unwrap_or(f64::NAN) / 1e6,
+        newton_per_step: newton / m.steps.max(1) as f64,
+        cg_per_newton: m.cg_iterations as f64 / newton.max(1.0),
+        peak_memory_mb: m.peak_memory_bytes.map_or(f64::NAN, |b| b as f64) / 1e6,
         paper_cpu_seconds_per_10ms: case.paper,
     })
 }

@@ -386,6 +386,13 @@ fn euler_elastica_from_complementary_modulus(complementary: f64) -> EulerElastic
     }
 }
 
+/// The pinned–pinned first-mode elastica of elliptic modulus k = sin(α/2), 0 ≤ k ≤ 1, in
+/// the closed form above: for drawing the curve at evenly spaced end angles (the viewer's
+/// Euler plot) rather than inverting it for one shortening.
+pub fn euler_elastica_from_modulus(k: f64) -> EulerElastica {
+    euler_elastica_from_complementary_modulus(complementary_modulus(k))
+}
+
 fn check_shortening(shortening_over_l: f64) {
     assert!(
         (0.0..2.0).contains(&shortening_over_l),

@@ -68,7 +68,7 @@ fn adaptive_cantilever_matches_the_elastica_in_fewer_steps() {
     let length = config.cloth.length;
     let lambda = f.areal_density * GRAVITY * length.powi(3) / f.bending_warp;
     let exact = heavy_cantilever(lambda).tip_drop_over_l;
-    let drop = |m: &rosette::scene::Metrics| m.measures["tip_drop"].as_f64().unwrap() / length;
+    let drop = |m: &rosette::scene::Metrics| m.measures.cantilever().expect("cantilever measures").tip_drop / length;
     println!(
         "λ {lambda:.2}: fixed {} steps, drop/L {:.4}; adaptive {} steps ({} rejected), {:.4}; elastica {exact:.4}",
         fixed.steps,

@@ -5,9 +5,9 @@
 mod common;
 
 use common::reference::{bending_rigidity_theta, heavy_cantilever};
-use rosette::scene::{RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use rosette::scene::{Measures, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 
-fn run(preset: &str, overrides: &[String]) -> (SceneConfig, serde_json::Value) {
+fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Measures) {
     let (config, _) = load_scene(preset, overrides).unwrap_or_else(|e| panic!("{e}"));
     let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
     let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
@@ -48,8 +48,9 @@ fn arc_check(warps: &[f64]) {
                     ("mesh.edge_length", "0.003".into()),
                 ]),
             );
-            let expected = m["moment"].as_f64().unwrap() / rigidity(&config, -warp);
-            let curvature = m["curvature"].as_f64().unwrap();
+            let m = m.arc().expect("arc measures");
+            let expected = m.moment / rigidity(&config, -warp);
+            let curvature = m.curvature;
             let error = (curvature - expected).abs() / expected;
             println!("arc warp {warp}° {integrator}: κ = {curvature:.4} 1/m, m/B_θ = {expected:.4}, error {:.3} %", error * 100.0);
             assert!(error < 0.01, "warp {warp}°, {integrator}: κ = {curvature}, m/B_θ = {expected}");
@@ -83,7 +84,7 @@ fn arc_rigidity_off_axis_converges_to_b_theta_as_the_edge_layers_shrink() {
                     ("test.clamp_length", "0.004".into()),
                 ]),
             );
-            m["rigidity"].as_f64().unwrap() / rigidity(&config, -warp)
+            m.arc().expect("arc measures").rigidity.expect("the strip bent") / rigidity(&config, -warp)
         };
         let (narrow, wide) = (ratio(0.1), ratio(0.2));
         let extrapolated = 2.0 * wide - narrow;
@@ -116,8 +117,9 @@ fn cantilever_check(patterns: &[&str], warps: &[f64], fabric: &[&str]) {
                 overrides.extend(fabric.iter().cloned());
                 let (_, m) = run("cantilever", &overrides);
                 let exact = heavy_cantilever(lambda);
-                let drop = m["tip_drop"].as_f64().unwrap() / length;
-                let angle = m["tip_angle_deg"].as_f64().unwrap();
+                let m = m.cantilever().expect("cantilever measures");
+                let drop = m.tip_drop / length;
+                let angle = m.tip_angle_deg;
                 let exact_angle = exact.tip_angle_rad.to_degrees();
                 let (drop_error, angle_error) =
                     ((drop - exact.tip_drop_over_l).abs() / exact.tip_drop_over_l, (angle - exact_angle).abs() / exact_angle);
@@ -183,7 +185,7 @@ fn cantilever_error_shrinks_on_refinement() {
                 ("test.clamp_length", (length / 6.0).to_string()),
             ]),
         );
-        let drop = m["tip_drop"].as_f64().unwrap() / length;
+        let drop = m.cantilever().expect("cantilever measures").tip_drop / length;
         errors.push((drop - exact.tip_drop_over_l).abs());
     }
     println!("cantilever λ = 8 tip-drop errors at 6, 12, 24 cells: {errors:?}");
@@ -204,10 +206,11 @@ fn arc_follows_a_nonlinear_moment_curvature_curve() {
         ]),
     );
     assert_eq!(config.fabric.bending_warp, 9e-6, "the curve's initial slope is the warp rigidity");
-    let kappa = m["curvature"].as_f64().unwrap();
+    let m = m.arc().expect("arc measures");
+    let kappa = m.curvature;
     // The curve at the measured curvature, interpolated here.
     let expected = 9.0e-5 + (kappa - 10.0) * (5.4e-4 - 9.0e-5) / 20.0;
-    let moment = m["moment"].as_f64().unwrap();
+    let moment = m.moment;
     let error = (moment - expected).abs() / expected;
     println!("nonlinear arc: κ = {kappa:.3} 1/m, moment {moment:.4e} vs curve {expected:.4e} ({:.2} %)", error * 100.0);
     assert!(error < 0.01, "{moment} vs {expected}");
@@ -228,7 +231,8 @@ fn settled_cantilever_stops_early_with_the_same_answer() {
     assert_eq!(early.settled, Some(true));
     assert_eq!(complete.settled, None);
     assert!(early.simulated_seconds < 0.7 * complete.simulated_seconds, "{} s vs {} s", early.simulated_seconds, complete.simulated_seconds);
-    let (a, b) = (early.measures["tip_drop"].as_f64().unwrap(), complete.measures["tip_drop"].as_f64().unwrap());
+    let tip_drop = |m: &Measures| m.cantilever().expect("cantilever measures").tip_drop;
+    let (a, b) = (tip_drop(&early.measures), tip_drop(&complete.measures));
     println!("settled at {:?} s: tip drop {a} vs {b} after the full {} s", early.settle_time, complete.simulated_seconds);
     assert!((a - b).abs() < 1e-3 * b);
 }

@@ -4,9 +4,9 @@
 mod common;
 
 use common::reference::euler_elastica_from_shortening;
-use rosette::scene::{RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use rosette::scene::{Measures, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 
-fn run(preset: &str, overrides: &[&str]) -> (SceneConfig, serde_json::Value) {
+fn run(preset: &str, overrides: &[&str]) -> (SceneConfig, Measures) {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let (config, _) = load_scene(preset, &overrides).unwrap_or_else(|e| panic!("{e}"));
     let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
@@ -40,7 +40,7 @@ fn euler_onset_load_is_pi_squared_b_over_l_squared() {
                 "mesh.edge_length=0.005",
             ],
         );
-        let measured = m["critical_load"].as_f64().expect("the strip buckled");
+        let measured = m.euler().expect("Euler measures").critical_load.expect("the strip buckled");
         let expected = euler_load(&config);
         let error = (measured - expected).abs() / expected;
         println!("{integrator}: onset {measured:.5} N/m vs π²B/L² = {expected:.5} N/m ({:.2} %)", error * 100.0);
@@ -55,20 +55,21 @@ fn euler_onset_load_is_pi_squared_b_over_l_squared() {
 #[test]
 fn euler_post_buckling_follows_the_elastica_and_settles_to_one_lobe() {
     let (config, m) = run("euler-buckling", &[]);
-    let shortening = m["end_shortening"].as_f64().unwrap();
+    let m = m.euler().expect("Euler measures");
+    let shortening = m.end_shortening;
     let elastica = euler_elastica_from_shortening(shortening);
     let length = config.cloth.length;
-    let deflection = m["midspan_deflection"].as_f64().unwrap() / length;
-    let force = m["end_force"].as_f64().unwrap() / euler_load(&config);
+    let deflection = m.midspan_deflection / length;
+    let force = m.end_force / euler_load(&config);
     println!(
-        "Δ/L = {shortening}: δ/L {deflection:.4} vs {:.4}, P/P_cr {force:.4} vs {:.4}; lobes {}; history {}",
-        elastica.midspan_deflection_over_l, elastica.load_over_pcr, m["lobes"], m["lobe_history"]
+        "Δ/L = {shortening}: δ/L {deflection:.4} vs {:.4}, P/P_cr {force:.4} vs {:.4}; lobes {}; history {:?}",
+        elastica.midspan_deflection_over_l, elastica.load_over_pcr, m.lobes, m.lobe_history
     );
     assert!((deflection - elastica.midspan_deflection_over_l).abs() / elastica.midspan_deflection_over_l < 0.03);
     assert!((force - elastica.load_over_pcr).abs() / elastica.load_over_pcr < 0.03);
-    assert_eq!(m["lobes"], 1, "final shape");
-    let history = m["lobe_history"].as_array().unwrap();
-    let first = history.first().and_then(|h| h[1].as_u64()).unwrap();
+    assert_eq!(m.lobes, 1, "final shape");
+    let history = &m.lobe_history;
+    let first = history.first().map(|h| h.1).unwrap();
     assert!(first >= 2, "under fast compression a higher mode shows first: {history:?}");
 }
 
@@ -79,14 +80,15 @@ fn euler_post_buckling_follows_the_elastica_and_settles_to_one_lobe() {
 #[test]
 fn shear_wrinkles_run_along_the_tension_field() {
     let (config, m) = run("shear-buckling", &[]);
-    let gamma = m["shear_angle_deg"].as_f64().unwrap();
+    let m = m.shear().expect("shear measures");
+    let gamma = m.shear_angle_deg;
     assert!((gamma - config.test.shear_angle_deg.unwrap()).abs() < 0.1);
     let predicted = 45.0 - gamma / 2.0;
-    let crest = m["wrinkle_angle_deg"].as_f64().unwrap();
-    let amplitude = m["wrinkle_amplitude"].as_f64().unwrap();
+    let crest = m.wrinkle_angle_deg;
+    let amplitude = m.wrinkle_amplitude;
     println!("crests at {crest:.1}° vs tension field {predicted:.1}°; {} wrinkles, amplitude {amplitude:.2e} m, wavelength {} m",
-        m["wrinkle_count"], m["wrinkle_wavelength"]);
+        m.wrinkle_count, m.wrinkle_wavelength);
     assert!(amplitude > 10.0 * config.test.perturbation.unwrap(), "wrinkles grew well beyond the initial perturbation");
-    assert!(m["wrinkle_count"].as_u64().unwrap() >= 2);
+    assert!(m.wrinkle_count >= 2);
     assert!((crest - predicted).abs() < 10.0, "{crest} vs {predicted}");
 }

@@ -3,7 +3,7 @@
 //! and metrics on standard output.
 
 use rosette::scene::preset::SCENES;
-use rosette::scene::{Scene, load_scene};
+use rosette::scene::{Metrics, Scene, load_scene};
 use serde_json::Value;
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -70,9 +70,14 @@ fn run_bundled(name: &str) {
     let elapsed = started.elapsed().as_secs_f64();
     eprintln!("rosette run {name}: {elapsed:.1} s wall");
     assert_eq!(out.status.code(), Some(0), "{name}: {}", text(&out.stderr));
-    let metrics: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let written = std::fs::read_to_string(&path).unwrap();
     std::fs::remove_file(&path).ok();
+    let metrics: Value = serde_json::from_str(&written).unwrap();
     assert_has_keys(&metrics, name);
+    // The typed report reads the file back and writes it out again unchanged (what
+    // `rosette bench` relies on).
+    let typed: Metrics = serde_json::from_str(&written).unwrap_or_else(|e| panic!("{name}: the metrics do not read back: {e}"));
+    assert_eq!(serde_json::to_string_pretty(&typed).unwrap() + "\n", written, "{name}: the metrics change when read back and written");
     let dt = config.solver.dt;
     let duration = config.scene.duration;
     assert_eq!(metrics["preset"], name);
@@ -105,6 +110,8 @@ fn run_bundled(name: &str) {
     assert!(cpu.is_finite() && cpu > 0.0, "{name}: cpu_seconds_per_simulated_second {cpu}");
     let measures = metrics["measures"].as_object().expect("measures is an object");
     assert!(!measures.is_empty(), "{name}: no measurements");
+    // Read back as the scene's own rig's measures, not another rig's.
+    assert_eq!(std::mem::discriminant(&typed.measures), std::mem::discriminant(&scene.measures()), "{name}: {:?}", typed.measures);
     if !config.props.is_empty() {
         let depth = metrics["max_penetration"].as_f64().expect("scenes with props report max_penetration");
         assert!(depth >= 0.0 && depth < config.contact.thickness, "{name}: max_penetration {depth}");

@@ -18,7 +18,7 @@ fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Metrics) {
 }
 
 fn drape_coefficient(m: &Metrics) -> f64 {
-    m.measures["drape_coefficient"].as_f64().unwrap()
+    m.measures.drape().expect("drape measures").drape_coefficient
 }
 
 /// Runs `preset` for several override sets on both cores.
@@ -54,7 +54,7 @@ fn every_fabric_settles_into_clean_folds_above_the_strip_bound() {
     );
     for ((fabric, _, _), (config, m)) in MEASURED.iter().zip(&results) {
         let dc = drape_coefficient(m);
-        let nodes = m.measures["nodes"].as_u64().unwrap();
+        let nodes = m.measures.drape().expect("drape measures").nodes;
         println!("{fabric}: DC {dc:.3}, {nodes} nodes, settled at {:?} s", m.settle_time);
         assert_eq!(m.settled, Some(true), "{fabric} never settled");
         let bound = strip_bound(config);
@@ -126,7 +126,7 @@ fn drape_coefficient_agrees_between_two_resolved_meshes() {
 fn random_starts_scatter_the_coefficient_by_a_few_hundredths() {
     let results = run_all("cusick-drape", (1..=3).map(|seed| vec![format!("scene.seed={seed}")]).collect());
     let dcs: Vec<f64> = results.iter().map(|r| drape_coefficient(&r.1)).collect();
-    let nodes: Vec<u64> = results.iter().map(|r| r.1.measures["nodes"].as_u64().unwrap()).collect();
+    let nodes: Vec<usize> = results.iter().map(|r| r.1.measures.drape().expect("drape measures").nodes).collect();
     println!("DC {dcs:?}, nodes {nodes:?}");
     let spread = dcs.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - dcs.iter().cloned().fold(f64::INFINITY, f64::min);
     assert!(spread < 0.05, "seeds scatter DC by {spread:.3}");

@@ -365,6 +365,20 @@ fn euler_elastica_elliptic_and_shooting_methods_agree() {
 }
 
 #[test]
+fn euler_elastica_from_the_modulus_is_the_one_from_the_shortening() {
+    // The viewer draws the curve at evenly spaced moduli; each point is the elastica that
+    // the shortening it gives leads back to.
+    for k in [0.05, 0.3, 0.6, 0.9, 0.95] {
+        let shape = euler_elastica_from_modulus(k);
+        assert_close(&format!("k at k = {k}"), shape.k, k, 1e-13);
+        let back = euler_elastica_from_shortening(shape.shortening_over_l);
+        assert_close(&format!("k back at k = {k}"), back.k, k, 1e-12);
+        assert_close(&format!("P/P_cr at k = {k}"), shape.load_over_pcr, back.load_over_pcr, 1e-12);
+        assert_close(&format!("δ/L at k = {k}"), shape.midspan_deflection_over_l, back.midspan_deflection_over_l, 1e-12);
+    }
+}
+
+#[test]
 fn euler_elastica_handles_near_loop_shortening() {
     // Δ/L = 1.9 needs k within 1e-16 of 1; there K = 2/(2 − Δ/L) = 20 exactly and
     // δ/L = k/K = 0.05, which only the complementary-modulus parametrisation resolves.

@@ -6,6 +6,7 @@
 mod common;
 
 use common::reference::*;
+use rosette::scene::measures::TensileMeasures;
 use rosette::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 
 /// Below this extensometer strain the start of the pull is not quasi-static: the grip jumps
@@ -33,12 +34,11 @@ fn run(preset: &str, overrides: &[&str]) -> (SceneConfig, Metrics) {
 
 /// The rig's `[[extensometer strain, stress N/m], ...]` points.
 fn stress_strain(metrics: &Metrics) -> Vec<[f64; 2]> {
-    metrics.measures["stress_strain"]
-        .as_array()
-        .expect("stress_strain is an array")
-        .iter()
-        .map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()])
-        .collect()
+    tensile(metrics).stress_strain.clone()
+}
+
+fn tensile(metrics: &Metrics) -> &TensileMeasures {
+    metrics.measures.tensile().expect("tensile measures")
 }
 
 /// Linear interpolation of a measured curve (strictly increasing strains), continued past
@@ -199,16 +199,14 @@ fn warp_pull_poisson_ratio_is_the_input_nu_xy() {
     // about 3 % strain); a 4:1 strip puts it out of the grips' reach.
     let (config, metrics) = run("tensile-warp", &["cloth.length=0.2", "scene.duration=12"]);
     let expected = config.fabric.poisson_warp;
-    let nu = metrics.measures["poisson_ratio"].as_f64().unwrap();
+    let nu = tensile(&metrics).poisson_ratio;
     eprintln!("poisson ratio at the end of the pull {nu} (input {expected})");
     // 2 %: what remains is the rosette's second-order geometric terms (of order the 6 %
     // strain times the small spurious shear of the diagonals, well under 1 %).
     assert!(((nu - expected) / expected).abs() < 0.02, "poisson ratio {nu}, expected {expected}");
     // And all along the pull, not only at its end.
-    let lateral = metrics.measures["lateral_strain"].as_array().unwrap();
     let mut worst = 0.0f64;
-    for p in lateral {
-        let (strain, lateral) = (p[0].as_f64().unwrap(), p[1].as_f64().unwrap());
+    for &[strain, lateral] in &tensile(&metrics).lateral_strain {
         if strain > MIN_STRAIN {
             let ratio = -lateral / strain;
             worst = worst.max((ratio / expected - 1.0).abs());
@@ -252,7 +250,7 @@ fn bias_pull(length: f64) -> (f64, f64, f64, f64) {
     let nu45 = off_axis_poisson(ex, ey, f.shear_modulus, f.poisson_warp, theta);
     let points = stress_strain(&metrics);
     let measured_e = slope_through_origin(&points);
-    let measured_nu = metrics.measures["poisson_ratio"].as_f64().unwrap();
+    let measured_nu = tensile(&metrics).poisson_ratio;
     eprintln!(
         "bias pull, length {length} m: E45 {measured_e:.3} N/m vs formula {e45:.3} ({:+.2} %), ν45 {measured_nu:.4} vs {nu45:.4} ({:+.2} %)",
         100.0 * (measured_e / e45 - 1.0),

@@ -120,7 +120,7 @@ fn scene_stops_at_its_duration() {
     let done = worker.wait_for(WAIT, |s| s.finished);
     assert!(done.finished && !done.playing);
     assert_eq!(done.steps, 5);
-    let stress_strain = done.measures["stress_strain"].as_array().expect("tensile measures");
+    let stress_strain = &done.measures.tensile().expect("tensile measures").stress_strain;
     assert!(!stress_strain.is_empty());
 }
 

@@ -2,8 +2,8 @@
 //! test data as CSV. Plain functions from data to text (the dialogs live in `dialogs`), so
 //! tests check the formats without a window.
 
-use crate::scene::SceneConfig;
 use crate::scene::preset::FabricConfig;
+use crate::scene::{Measures, SceneConfig};
 use glam::{DVec2, DVec3};
 use std::fmt::Write;
 use std::path::Path;
@@ -51,50 +51,23 @@ pub fn mesh_obj(positions: &[DVec3], rest: &[DVec2], triangles: &[[u32; 3]]) -> 
     out
 }
 
-/// Column names of the rig's series (see `scene::rigs`), with units.
-fn series_columns(key: &str) -> Option<&'static [&'static str]> {
-    Some(match key {
-        "stress_strain" => &["strain", "stress_N_per_m"],
-        "clamp_stress_strain" => &["clamp_strain", "stress_N_per_m"],
-        "lateral_strain" => &["strain", "lateral_strain"],
-        "lobe_history" => &["time_s", "lobes"],
-        "force_history" => &["time_s", "end_shortening", "end_force_N_per_m", "amplitude_m"],
-        "quasi_static_force" | "dynamic_force" => &["end_shortening", "end_force_N_per_m"],
-        _ => return None,
-    })
-}
-
-/// Test data as CSV: the rig's final scalar measures (`measure,value`), then each of its
-/// series as its own table after a blank line, then the scalar measures sampled over time
-/// while the viewer watched (`history`: time, then `names`).
-pub fn measures_csv(measures: &serde_json::Value, names: &[String], history: &[(f64, Vec<f64>)]) -> String {
+/// Test data as CSV: the rig's final scalar measures (`measure,value`, each number as the
+/// metrics JSON writes it), then each of its series that has rows as its own table after
+/// a blank line, its columns named `series.column` (see [`Measures::series`]), then the
+/// scalar measures sampled over time while the viewer watched (`history`: time, then
+/// `names`).
+pub fn measures_csv(measures: &Measures, names: &[String], history: &[(f64, Vec<f64>)]) -> String {
     let mut out = String::from("measure,value\n");
-    let Some(map) = measures.as_object() else { return out };
-    for (key, value) in map {
-        match value {
-            serde_json::Value::Number(n) => {
-                let _ = writeln!(out, "{key},{n}");
-            }
-            serde_json::Value::Bool(b) => {
-                let _ = writeln!(out, "{key},{b}");
-            }
-            _ => {}
-        }
+    for (name, value) in measures.scalars() {
+        let _ = writeln!(out, "{name},{value}");
     }
-    for (key, value) in map {
-        let Some(rows) = value.as_array() else { continue };
-        let rows: Vec<Vec<f64>> =
-            rows.iter().filter_map(|r| r.as_array().map(|r| r.iter().filter_map(serde_json::Value::as_f64).collect())).collect();
-        if rows.is_empty() {
+    for series in measures.series() {
+        if series.rows.is_empty() {
             continue;
         }
-        let width = rows.iter().map(Vec::len).max().unwrap_or(0);
-        let header: Vec<String> = match series_columns(key) {
-            Some(columns) if columns.len() == width => columns.iter().map(|c| format!("{key}.{c}")).collect(),
-            _ => (0..width).map(|i| format!("{key}.{i}")).collect(),
-        };
+        let header: Vec<String> = series.columns.iter().map(|c| format!("{}.{c}", series.name)).collect();
         let _ = writeln!(out, "\n{}", header.join(","));
-        for row in rows {
+        for row in series.rows {
             let _ = writeln!(out, "{}", row.iter().map(f64::to_string).collect::<Vec<_>>().join(","));
         }
     }
@@ -111,6 +84,7 @@ pub fn measures_csv(measures: &serde_json::Value, names: &[String], history: &[(
 mod tests {
     use super::*;
     use crate::scene::load_scene;
+    use crate::scene::measures::{DrapeMeasures, TensileMeasures};
 
     #[test]
     fn scene_toml_loads_back_to_the_same_scene() {
@@ -145,15 +119,29 @@ mod tests {
 
     #[test]
     fn csv_has_scalars_series_and_history() {
-        let measures = serde_json::json!({
-            "poisson_ratio": 0.15,
-            "stress_strain": [[0.0, 0.0], [0.01, 2.5]],
-            "strain_definition": "text is left out",
+        let measures = Measures::Tensile(TensileMeasures {
+            final_strain: 0.01,
+            final_stress: 2.5,
+            poisson_ratio: 0.15,
+            stress_strain: vec![[0.0, 0.0], [0.01, 2.5]],
+            strain_definition: "text is left out".into(),
+            ..Default::default()
         });
         let csv = measures_csv(&measures, &["tip_drop".into()], &[(0.1, vec![0.02])]);
-        assert!(csv.starts_with("measure,value\npoisson_ratio,0.15\n"), "{csv}");
+        assert!(csv.starts_with("measure,value\nfinal_strain,0.01\nfinal_stress,2.5\npoisson_ratio,0.15\n"), "{csv}");
         assert!(csv.contains("\nstress_strain.strain,stress_strain.stress_N_per_m\n0,0\n0.01,2.5\n"), "{csv}");
+        // Series without rows are left out.
+        assert!(!csv.contains("lateral_strain"), "{csv}");
         assert!(csv.contains("\ntime_s,tip_drop\n0.1,0.02\n"), "{csv}");
         assert!(!csv.contains("text is left out"));
+    }
+
+    #[test]
+    fn csv_writes_counts_as_integers_and_names_the_drape_history_columns() {
+        let measures = Measures::Drape(DrapeMeasures { nodes: 6, drape_coefficient: 0.5, history: vec![(0.01, 0.9, 4)], ..Default::default() });
+        let csv = measures_csv(&measures, &[], &[]);
+        assert!(csv.contains("\nnodes,6\n"), "{csv}");
+        assert!(csv.contains("\ndrape_coefficient,0.5\n"), "{csv}");
+        assert!(csv.contains("\nhistory.time_s,history.drape_coefficient,history.nodes\n0.01,0.9,4\n"), "{csv}");
     }
 }

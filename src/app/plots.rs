@@ -4,7 +4,8 @@
 //! changes, see [`default_series`]).
 
 use super::worker::Snapshot;
-use crate::scene::SceneKind;
+use crate::reference::euler_elastica_from_modulus;
+use crate::scene::{Measures, SceneKind};
 use egui::Color32;
 use egui_plot::{Corner, HLine, Legend, Line, LineStyle, Plot, PlotBounds, PlotPoints, Points};
 
@@ -27,11 +28,7 @@ impl History {
     /// rigidity once the curvature is not zero) joins the list without clearing what was
     /// recorded; rows without it hold NaN there.
     pub fn record(&mut self, snapshot: &Snapshot) {
-        let scalars: Vec<(String, f64)> = snapshot
-            .measures
-            .as_object()
-            .map(|m| m.iter().filter_map(|(k, v)| Some((k.clone(), v.as_f64().filter(|x| x.is_finite())?))).collect())
-            .unwrap_or_default();
+        let scalars = snapshot.measures.scalars();
         if snapshot.scene_generation != self.generation {
             self.generation = snapshot.scene_generation;
             self.names.clear();
@@ -40,16 +37,16 @@ impl History {
         if self.rows.last().is_some_and(|(t, _)| *t >= snapshot.time) {
             return;
         }
-        for (name, _) in &scalars {
-            if !self.names.contains(name) {
-                self.names.push(name.clone());
+        for &(name, _) in &scalars {
+            if !self.names.iter().any(|n| n == name) {
+                self.names.push(name.to_string());
                 self.rows.iter_mut().for_each(|(_, v)| v.push(f64::NAN));
             }
         }
         let mut values = vec![f64::NAN; self.names.len()];
         for (name, value) in scalars {
-            let k = self.names.iter().position(|n| *n == name).expect("added above");
-            values[k] = value;
+            let k = self.names.iter().position(|n| n == name).expect("added above");
+            values[k] = value.value();
         }
         self.rows.push((snapshot.time, values));
         if self.rows.len() > HISTORY_LIMIT {
@@ -70,7 +67,8 @@ impl History {
 
 /// The measure the "over time" plot opens on for each kind of test: the rig's response,
 /// which changes while the test runs (not a setting such as the compression speed, or a
-/// constant of the fabric such as the bending length).
+/// constant of the fabric such as the bending length). It names one of the rig's
+/// [`Measures::scalars`].
 pub fn default_series(kind: SceneKind) -> &'static str {
     match kind {
         // The clamp force per width rises with the pull.
@@ -88,57 +86,27 @@ pub fn default_series(kind: SceneKind) -> &'static str {
     }
 }
 
-/// Complete elliptic integrals K(k) and E(k) of modulus k (0 ≤ k < 1) by the
-/// arithmetic–geometric mean.
-pub fn elliptic_ke(k: f64) -> (f64, f64) {
-    let (mut a, mut b) = (1.0f64, (1.0 - k * k).sqrt());
-    let mut sum = 0.5 * k * k;
-    let mut power = 0.5;
-    for _ in 0..40 {
-        let c = 0.5 * (a - b);
-        let (an, bn) = (0.5 * (a + b), (a * b).sqrt());
-        power *= 2.0;
-        sum += power * c * c;
-        a = an;
-        b = bn;
-        if c.abs() < 1e-16 {
-            break;
-        }
-    }
-    let big_k = std::f64::consts::FRAC_PI_2 / a;
-    (big_k, big_k * (1.0 - sum))
-}
-
-/// The pinned–pinned (first-mode) elastica: (end shortening Δ/L, P/P_cr) for end slopes up
-/// to `max_shortening`. With k = sin(α/2): P/P_cr = (2K/π)², Δ/L = 2 − 2E/K.
+/// The pinned–pinned (first-mode) elastica as the plot draws it: (end shortening Δ/L,
+/// P/P_cr) up to `max_shortening`, at evenly spaced elliptic moduli k = sin(α/2) from
+/// `crate::reference` (docs/references.md §5), so that the curve is dense where it bends.
 pub fn elastica(max_shortening: f64) -> Vec<[f64; 2]> {
     let mut out = vec![[0.0, 1.0]];
     for i in 1..200 {
-        let k = 0.95 * i as f64 / 200.0;
-        let (big_k, big_e) = elliptic_ke(k);
-        let shortening = 2.0 - 2.0 * big_e / big_k;
-        if shortening > max_shortening {
+        let shape = euler_elastica_from_modulus(0.95 * i as f64 / 200.0);
+        if shape.shortening_over_l > max_shortening {
             break;
         }
-        out.push([shortening, (2.0 * big_k / std::f64::consts::PI).powi(2)]);
+        out.push([shape.shortening_over_l, shape.load_over_pcr]);
     }
     out
-}
-
-fn array2(value: &serde_json::Value) -> Vec<[f64; 2]> {
-    value
-        .as_array()
-        .map(|rows| rows.iter().filter_map(|r| Some([r.get(0)?.as_f64()?, r.get(1)?.as_f64()?])).collect())
-        .unwrap_or_default()
 }
 
 /// Draws the plot that suits the running test; returns false when there is none (the
 /// caller then offers the scalar history).
 pub fn test_plot(ui: &mut egui::Ui, snapshot: &Snapshot) -> bool {
-    let measures = &snapshot.measures;
     let config = &snapshot.config;
-    if let Some(series) = measures.get("stress_strain") {
-        let measured = array2(series);
+    if let Measures::Tensile(tensile) = &*snapshot.measures {
+        let measured = tensile.stress_strain.clone();
         let angle = config.cloth.warp_angle_deg.rem_euclid(180.0);
         let (reference, label) = if angle.abs() < 1e-9 {
             (Some(&config.fabric.tensile_warp), "input warp curve")
@@ -166,8 +134,9 @@ pub fn test_plot(ui: &mut egui::Ui, snapshot: &Snapshot) -> bool {
         }
         return true;
     }
-    if let (Some(_), Some(euler)) = (measures.get("force_history"), measures.get("euler_load").and_then(|v| v.as_f64())) {
-        let points = euler_points(measures.get("quasi_static_force"), measures.get("dynamic_force"), euler);
+    if let Measures::Euler(measured) = &*snapshot.measures {
+        let euler = measured.euler_load;
+        let points = euler_points(&measured.quasi_static_force, &measured.dynamic_force, euler);
         // Fixed axes: shortening up to the run's own (the test's target, or further if the
         // scene ran on), P/P_cr up to EULER_FORCE_TOP, so that the dynamic spikes of a fast
         // compression (up to 20 P_cr) cannot squash the elastica's 1.0–1.05 into a line.
@@ -228,10 +197,10 @@ pub struct EulerPoints {
 /// `quasi_static_force` and `dynamic_force` (rows of Δ/L, P N/m; the rig sorts them by their
 /// out-of-balance load, see [`crate::scene::rigs::QUASI_STATIC_IMBALANCE`]) and `euler` is
 /// P_cr, N/m. Samples off the scale are dropped, not allowed to stretch the axis.
-pub fn euler_points(quasi_static: Option<&serde_json::Value>, dynamic: Option<&serde_json::Value>, euler: f64) -> EulerPoints {
+pub fn euler_points(quasi_static: &[[f64; 2]], dynamic: &[[f64; 2]], euler: f64) -> EulerPoints {
     let mut points = EulerPoints::default();
-    let mut on_scale = |rows: Option<&serde_json::Value>| -> Vec<[f64; 2]> {
-        let scaled = rows.map(array2).unwrap_or_default().into_iter().map(|[s, p]| [s, p / euler]);
+    let mut on_scale = |rows: &[[f64; 2]]| -> Vec<[f64; 2]> {
+        let scaled = rows.iter().map(|&[s, p]| [s, p / euler]);
         let (kept, dropped): (Vec<[f64; 2]>, Vec<[f64; 2]>) = scaled.partition(|p| (0.0..=EULER_FORCE_TOP).contains(&p[1]));
         points.off_scale += dropped.len();
         kept
@@ -250,16 +219,6 @@ pub fn history_plot(ui: &mut egui::Ui, history: &History, name: &str) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn elliptic_integrals_match_tables() {
-        let (k0, e0) = elliptic_ke(0.0);
-        assert!((k0 - std::f64::consts::FRAC_PI_2).abs() < 1e-15 && (e0 - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
-        // m = k² = 0.5 (Abramowitz & Stegun table 17.1).
-        let (k, e) = elliptic_ke(0.5f64.sqrt());
-        assert!((k - 1.854_074_677_301_372).abs() < 1e-12, "{k}");
-        assert!((e - 1.350_643_881_047_675).abs() < 1e-12, "{e}");
-    }
 
     #[test]
     fn elastica_starts_at_the_euler_load_with_slope_one_half() {

@@ -12,7 +12,7 @@
 //! time follows wall time, and when it is slower it runs flat out and reports the
 //! real-time factor. Nothing here depends on a GUI crate, so tests drive it directly.
 
-use crate::scene::{Scene, SceneConfig, SettleWatch, load_scene, preset::FabricConfig};
+use crate::scene::{Measures, Scene, SceneConfig, SettleWatch, load_scene, preset::FabricConfig};
 use crate::sim::{Integrator, IntegratorKind, State};
 use glam::DVec3;
 use std::collections::VecDeque;
@@ -135,7 +135,7 @@ pub struct Snapshot {
     pub settled_at: Option<f64>,
     pub stats: Stats,
     /// The rig's measurements (`Scene::measures`), for live plots.
-    pub measures: Arc<serde_json::Value>,
+    pub measures: Arc<Measures>,
     /// The last error (a bad scene or fabric, a diverged step), until the next success.
     pub error: Option<String>,
     /// The vertex held by the mouse, if any.

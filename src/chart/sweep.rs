@@ -3,7 +3,7 @@
 //! explicit stability limit each run is compared with.
 
 use crate::reference::{euler_elastica_from_shortening, heavy_cantilever};
-use crate::scene::{GRAVITY, RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use crate::scene::{GRAVITY, Measures, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 use crate::sim::IntegratorKind;
 use glam::DVec3;
 
@@ -227,8 +227,8 @@ pub fn explicit_limit(scene: &Scene) -> f64 {
 
 /// The problem's measure and its error against the analytic answer (`None` for the drape,
 /// whose reference is another run).
-fn measure_error(problem: Problem, config: &SceneConfig, measures: &serde_json::Value) -> Result<(f64, Option<f64>), String> {
-    let number = |key: &str| measures[key].as_f64().ok_or_else(|| format!("{}: no `{key}` in the measures", problem.name()));
+fn measure_error(problem: Problem, config: &SceneConfig, measures: &Measures) -> Result<(f64, Option<f64>), String> {
+    let other_rig = || format!("{}: the scene's rig does not measure this problem", problem.name());
     let length = config.cloth.length;
     match problem {
         Problem::Cantilever => {
@@ -236,21 +236,22 @@ fn measure_error(problem: Problem, config: &SceneConfig, measures: &serde_json::
             let weight = config.fabric.areal_density * GRAVITY;
             let lambda = weight * length.powi(3) / config.fabric.bending_warp;
             let exact = heavy_cantilever(lambda).tip_drop_over_l;
-            let drop = number("tip_drop")? / length;
+            let drop = measures.cantilever().ok_or_else(other_rig)?.tip_drop / length;
             Ok((drop, Some((drop - exact).abs() / exact)))
         }
         Problem::Buckling => {
-            let exact = euler_elastica_from_shortening(number("end_shortening")?).midspan_deflection_over_l;
-            let deflection = number("midspan_deflection")? / length;
+            let euler = measures.euler().ok_or_else(other_rig)?;
+            let exact = euler_elastica_from_shortening(euler.end_shortening).midspan_deflection_over_l;
+            let deflection = euler.midspan_deflection / length;
             Ok((deflection, Some((deflection - exact).abs() / exact)))
         }
         Problem::Tensile => {
-            let curve = measures["stress_strain"].as_array().ok_or("tensile: no stress_strain in the measures")?;
+            let curve = &measures.tensile().ok_or_else(other_rig)?.stress_strain;
             let input = &config.fabric.tensile_warp;
             let mut worst = 0.0f64;
             let mut compared = 0;
-            for point in curve {
-                let (Some(strain), Some(stress)) = (point[0].as_f64(), point[1].as_f64()) else { continue };
+            // A point that is not finite (written as null in the metrics) is not compared.
+            for &[strain, stress] in curve.iter().filter(|p| p.iter().all(|v| v.is_finite())) {
                 if strain > TENSILE_MIN_STRAIN {
                     let expected = interpolate(input, strain);
                     worst = worst.max((stress - expected).abs() / expected);
@@ -261,7 +262,7 @@ fn measure_error(problem: Problem, config: &SceneConfig, measures: &serde_json::
             let error = (compared >= 10).then_some(worst);
             Ok((worst, error))
         }
-        Problem::Drape => Ok((number("drape_coefficient")?, None)),
+        Problem::Drape => Ok((measures.drape().ok_or_else(other_rig)?.drape_coefficient, None)),
     }
 }
 

@@ -2,14 +2,16 @@
 //! One registry (`preset::SCENES`) feeds the command line, the tests and the viewer.
 
 pub mod drape;
+pub mod measures;
 pub mod preset;
 pub mod props;
 pub mod rigs;
 pub mod run;
 pub mod strip;
 
+pub use measures::Measures;
 pub use preset::{SceneConfig, SceneKind, load_scene};
-pub use run::{Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
+pub use run::{ContactEvents, Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
 
 use crate::sim::contact::{ContactModel, ContactSettings};
 use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};
@@ -114,8 +116,8 @@ impl Scene {
         Ok(report)
     }
 
-    /// The rig's measurements as JSON.
-    pub fn measures(&self) -> serde_json::Value {
+    /// The rig's measurements now.
+    pub fn measures(&self) -> Measures {
         self.rig.finish(&self.model, &self.state)
     }
 }

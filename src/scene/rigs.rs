@@ -1,11 +1,11 @@
 //! Test rigs: how each laboratory test holds and drives the cloth, and what it measures.
 
-use super::strip::{Columns, count_half_waves, fit_circle_radius, group_force, vertices_where};
+use super::measures::{ArcMeasures, CantileverMeasures, DrapeMeasures, EulerMeasures, Measures, ShearMeasures, TensileMeasures};
 use super::preset::ShearKinematics;
+use super::strip::{Columns, count_half_waves, fit_circle_radius, group_force, vertices_where};
 use super::{SceneConfig, SceneError, SceneKind, drape};
 use crate::sim::{Model, Motion, State};
 use glam::{DVec2, DVec3};
-use serde_json::json;
 
 /// Rest coordinates are compared with this tolerance when picking edge vertices, m.
 const ON_EDGE: f64 = 1e-9;
@@ -265,7 +265,7 @@ impl Rig {
     }
 
     /// The rig's measurements at the end of the run.
-    pub fn finish(&self, model: &Model, state: &State) -> serde_json::Value {
+    pub fn finish(&self, model: &Model, state: &State) -> Measures {
         match self {
             Rig::Tensile(r) => {
                 // A few dozen evenly spaced points of the pull.
@@ -273,14 +273,14 @@ impl Rig {
                 let picked: Vec<&[f64; 4]> = r.samples.iter().step_by(stride).collect();
                 let last = r.samples.last().copied().unwrap_or([0.0; 4]);
                 let poisson = if last[1].abs() > 0.0 { -last[2] / last[1] } else { 0.0 };
-                json!({
-                    "stress_strain": picked.iter().map(|s| [s[1], s[3]]).collect::<Vec<_>>(),
-                    "clamp_stress_strain": picked.iter().map(|s| [s[0], s[3]]).collect::<Vec<_>>(),
-                    "lateral_strain": picked.iter().map(|s| [s[1], s[2]]).collect::<Vec<_>>(),
-                    "poisson_ratio": poisson,
-                    "final_stress": last[3],
-                    "final_strain": last[1],
-                    "strain_definition": "extensometer over the central half of the gauge length; stress = moving-clamp force / initial width",
+                Measures::Tensile(TensileMeasures {
+                    stress_strain: picked.iter().map(|s| [s[1], s[3]]).collect(),
+                    clamp_stress_strain: picked.iter().map(|s| [s[0], s[3]]).collect(),
+                    lateral_strain: picked.iter().map(|s| [s[1], s[2]]).collect(),
+                    poisson_ratio: poisson,
+                    final_stress: last[3],
+                    final_strain: last[1],
+                    strain_definition: TensileMeasures::STRAIN_DEFINITION.to_string(),
                 })
             }
             Rig::Cantilever(r) => {
@@ -291,13 +291,13 @@ impl Rig {
                 let tangent = tip - before;
                 let weight = model.mass.iter().sum::<f64>() / model.vertex_area.iter().sum::<f64>() * super::GRAVITY;
                 let b = model.bending_stiffness.rigidity_at(-model.warp_angle);
-                json!({
-                    "tip_drop": drop,
-                    "tip_reach": tip.x,
-                    "tip_angle_deg": (-tangent.z).atan2(tangent.x).to_degrees(),
-                    "chord_angle_deg": drop.atan2(tip.x).to_degrees(),
-                    "lambda": weight * r.length.powi(3) / b,
-                    "bending_length": (b / weight).cbrt(),
+                Measures::Cantilever(CantileverMeasures {
+                    tip_drop: drop,
+                    tip_reach: tip.x,
+                    tip_angle_deg: (-tangent.z).atan2(tangent.x).to_degrees(),
+                    chord_angle_deg: drop.atan2(tip.x).to_degrees(),
+                    lambda: weight * r.length.powi(3) / b,
+                    bending_length: (b / weight).cbrt(),
                 })
             }
             Rig::Arc(r) => {
@@ -321,11 +321,7 @@ impl Rig {
                 let pivot = line[r.columns.nearest(0.5 * r.length)];
                 let torque: f64 = r.grip.iter().map(|&v| (state.x[v as usize] - pivot).cross(f[v as usize]).y).sum();
                 let moment = torque / r.width;
-                json!({
-                    "curvature": curvature,
-                    "moment": moment,
-                    "rigidity": if curvature > 0.0 { moment / curvature } else { f64::INFINITY },
-                })
+                Measures::Arc(ArcMeasures { curvature, moment, rigidity: (curvature > 0.0).then(|| moment / curvature) })
             }
             Rig::Euler(r) => {
                 let critical = r.history.iter().find(|h| h.3 > 0.05 * r.length).map(|h| h.2);
@@ -333,8 +329,8 @@ impl Rig {
                 let mid = r.columns.nearest(0.5 * r.length);
                 let last = r.history.last().copied().unwrap_or_default();
                 let (quasi_static, dynamic): (Vec<_>, Vec<_>) = r.history.iter().partition(|h| h.5 < QUASI_STATIC_IMBALANCE);
-                let force_curve = |samples: &[&(f64, f64, f64, f64, usize, f64)]| -> Vec<serde_json::Value> {
-                    samples.iter().step_by((samples.len() / 100).max(1)).map(|h| json!([h.1, h.2])).collect()
+                let force_curve = |samples: &[&(f64, f64, f64, f64, usize, f64)]| -> Vec<[f64; 2]> {
+                    samples.iter().step_by((samples.len() / 100).max(1)).map(|h| [h.1, h.2]).collect()
                 };
                 // Lobe history as (t, lobes) at each change.
                 let mut lobe_history: Vec<(f64, usize)> = Vec::new();
@@ -343,35 +339,37 @@ impl Rig {
                         lobe_history.push((h.0, h.4));
                     }
                 }
-                json!({
-                    "critical_load": critical,
-                    "critical_load_definition": "end force when the largest normal deflection first exceeds 5 % of the length",
-                    "euler_load": r.euler_load(model),
-                    "end_force": last.2,
-                    "end_shortening": last.1,
-                    "midspan_deflection": line[mid].z.abs(),
-                    "lobes": last.4,
-                    "lobe_history": lobe_history.iter().map(|l| json!([l.0, l.1])).collect::<Vec<_>>(),
-                    "compression_speed": r.speed,
-                    "out_of_balance": last.5,
-                    "out_of_balance_definition": "sum of |force| on the free vertices over the Euler load's total P_cr·w; 0 in static equilibrium",
-                    "quasi_static_force": force_curve(&quasi_static),
-                    "dynamic_force": force_curve(&dynamic),
-                    "force_history": r.history.iter().step_by((r.history.len() / 100).max(1)).map(|h| json!([h.0, h.1, h.2, h.3])).collect::<Vec<_>>(),
+                Measures::Euler(EulerMeasures {
+                    critical_load: critical,
+                    critical_load_definition: EulerMeasures::CRITICAL_LOAD_DEFINITION.to_string(),
+                    euler_load: r.euler_load(model),
+                    end_force: last.2,
+                    end_shortening: last.1,
+                    midspan_deflection: line[mid].z.abs(),
+                    lobes: last.4,
+                    lobe_history,
+                    compression_speed: r.speed,
+                    out_of_balance: last.5,
+                    out_of_balance_definition: EulerMeasures::OUT_OF_BALANCE_DEFINITION.to_string(),
+                    quasi_static_force: force_curve(&quasi_static),
+                    dynamic_force: force_curve(&dynamic),
+                    force_history: r.history.iter().step_by((r.history.len() / 100).max(1)).map(|h| [h.0, h.1, h.2, h.3]).collect(),
                 })
             }
-            Rig::Shear(r) => shear_measures(r, model, state),
+            Rig::Shear(r) => Measures::Shear(shear_measures(r, model, state)),
             Rig::Drape(r) => {
                 let (shadow, dc, nodes) = r.measure(model, state, 1024);
-                json!({
-                    "drape_coefficient": dc,
-                    "nodes": nodes,
-                    "shadow_area": shadow.area,
-                    "specimen_area": r.specimen_area,
-                    "support_area": r.support_area,
-                    "outline_radius_min": shadow.outline.iter().map(|o| o.1).fold(f64::INFINITY, f64::min),
-                    "outline_radius_max": shadow.outline.iter().map(|o| o.1).fold(0.0, f64::max),
-                    "history": r.history.iter().step_by((r.history.len() / 100).max(1)).map(|h| json!([h.0, h.1, h.2])).collect::<Vec<_>>(),
+                let radius_min = shadow.outline.iter().map(|o| o.1).fold(f64::INFINITY, f64::min);
+                Measures::Drape(DrapeMeasures {
+                    drape_coefficient: dc,
+                    nodes,
+                    shadow_area: shadow.area,
+                    specimen_area: r.specimen_area,
+                    support_area: r.support_area,
+                    // None when the outline is empty.
+                    outline_radius_min: radius_min.is_finite().then_some(radius_min),
+                    outline_radius_max: shadow.outline.iter().map(|o| o.1).fold(0.0, f64::max),
+                    history: r.history.iter().step_by((r.history.len() / 100).max(1)).copied().collect(),
                 })
             }
         }
@@ -387,7 +385,7 @@ impl Rig {
 }
 
 /// Wrinkle direction, count and wavelength from the normal deflection field.
-fn shear_measures(r: &Shear, model: &Model, state: &State) -> serde_json::Value {
+fn shear_measures(r: &Shear, model: &Model, state: &State) -> ShearMeasures {
     // Angle between the deformed cross direction (clamp to grip) and its rest direction.
     let grip = state.x[r.moving[0] as usize] - DVec3::new(model.rest[r.moving[0] as usize].x, 0.0, 0.0);
     let shear_angle = grip.x.atan2(grip.y);
@@ -439,13 +437,13 @@ fn shear_measures(r: &Shear, model: &Model, state: &State) -> serde_json::Value 
     let half_waves = count_half_waves(&zs, 0.2);
     let span = profile.last().map_or(0.0, |p| p.0) - profile.first().map_or(0.0, |p| p.0);
     let wavelength = if half_waves >= 2 { 2.0 * span / half_waves as f64 } else { 0.0 };
-    json!({
-        "shear_angle_deg": shear_angle.to_degrees(),
-        "wrinkle_angle_deg": crest_angle.to_degrees(),
-        "wrinkle_count": half_waves.div_ceil(2),
-        "wrinkle_wavelength": wavelength,
-        "wrinkle_amplitude": amplitude,
-    })
+    ShearMeasures {
+        shear_angle_deg: shear_angle.to_degrees(),
+        wrinkle_angle_deg: crest_angle.to_degrees(),
+        wrinkle_count: half_waves.div_ceil(2),
+        wrinkle_wavelength: wavelength,
+        wrinkle_amplitude: amplitude,
+    }
 }
 
 /// z of the deformed surface above the point `q` of the xy plane (first triangle found).

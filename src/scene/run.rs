@@ -1,12 +1,13 @@
 //! Running a scene to its end: the step loop, divergence handling and the metrics report.
 
-use super::Scene;
+use super::{Measures, Scene};
 use crate::sim::{StepError, StepTimings};
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 use std::time::Instant;
 
-/// What a run reports (written as JSON by `rosette run --metrics`).
-#[derive(Debug, Clone, Serialize)]
+/// What a run reports (written as JSON by `rosette run --metrics`, and read back from it
+/// by `rosette bench`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Metrics {
     pub preset: String,
     pub integrator: String,
@@ -42,7 +43,7 @@ pub struct Metrics {
     /// Steps solved again for a contact the prediction missed, and crossings stopped by
     /// the self-collision fail-safe.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub contact_events: Option<serde_json::Value>,
+    pub contact_events: Option<ContactEvents>,
     pub newton_iterations: u64,
     pub cg_iterations: u64,
     /// Preconditioners built for the linear solves (factorisations).
@@ -53,8 +54,32 @@ pub struct Metrics {
     /// Steps the adaptive control took again with a smaller Δt.
     pub rejected_steps: u64,
     /// Seconds of the run spent in each phase of the steps.
+    #[serde(deserialize_with = "step_timings")]
     pub step_time: StepTimings,
-    pub measures: serde_json::Value,
+    pub measures: Measures,
+}
+
+/// What the contact handling had to do over a run (`Metrics::contact_events`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ContactEvents {
+    /// Crossings stopped by the self-collision fail-safe (impact zones).
+    pub impacts: u64,
+    /// Steps solved again for a contact the prediction missed.
+    pub resolves: u64,
+}
+
+/// Reads `Metrics::step_time` back: the solver's `StepTimings` only serialises (the
+/// physics has no need to read it), so its fields are named here; a field the metrics
+/// lack is an error, not a zero.
+fn step_timings<'de, D: Deserializer<'de>>(deserializer: D) -> Result<StepTimings, D::Error> {
+    #[derive(Deserialize)]
+    struct Phases {
+        forces: f64,
+        solve: f64,
+        contact: f64,
+    }
+    let Phases { forces, solve, contact } = Phases::deserialize(deserializer)?;
+    Ok(StepTimings { forces, solve, contact })
 }
 
 /// How to run a scene; `RunOptions::default()` runs it for its own duration, silently.
@@ -265,7 +290,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             .map(|_| crate::sim::contact::count_self_intersections(&scene.state.x, &scene.model.triangles, &scene.model.edges)),
         contact_events: scene.model.contact.as_ref().map(|_| {
             let s = scene.integrator.contact_stats;
-            serde_json::json!({ "resolves": s.resolves, "impacts": s.impacts })
+            ContactEvents { impacts: s.impacts, resolves: s.resolves }
         }),
         newton_iterations: newton,
         cg_iterations: cg,
