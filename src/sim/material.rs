@@ -1,7 +1,7 @@
 //! Fabric material laws: the in-plane strain energy of a woven sheet and its bending
 //! stiffness tensor.
 //!
-//! Conventions (REFERENCE.md §1): x is the warp, y the weft. `nu_xy` is the contraction
+//! Conventions (docs/references.md §1): x is the warp, y the weft. `nu_xy` is the contraction
 //! along the weft per unit strain under a warp pull; reciprocity gives
 //! `nu_yx = nu_xy · E_y / E_x` from the small-strain moduli. Fabric quantities are per unit
 //! width: stresses and moduli in N/m, bending rigidities in N·m.

@@ -40,7 +40,7 @@ impl NearPairs {
         let pad = DVec3::splat(reach);
         // The hash returns an item once per cell it overlaps (and its bucket-mates): each
         // query marks what it has taken with its own number instead of searching a list of
-        // them, which took about a quarter of the search's time at 20 000 triangles.
+        // them, which costs a search per item found.
         let vertex_triangle = search_in_chunks(triangles.len(), x.len(), parallel, |t, taken, found| {
             let tri = triangles[t];
             let c = tri.map(|i| x[i as usize]);

@@ -351,15 +351,14 @@ impl ContactModel {
 }
 
 /// On meshes of at least this many triangles the searches run on rayon's threads. On
-/// smaller ones a search takes tens of microseconds, about what handing it out costs (on the
-/// paper's drape, 875 triangles, the pair filters on rayon's threads took half again as
-/// long as on one).
+/// smaller ones a search takes tens of microseconds, about what handing it out costs, and
+/// the threads would make it slower.
 const PARALLEL_TRIANGLES: usize = 4096;
 
 /// What `keep(i, &items[i])` returns, in the order of i (if `parallel`, fixed chunks on
 /// rayon's threads). Both paths run the same loop over a chunk, which `keep` is inlined
-/// into: with an iterator adapter on each path it was not, and the paper's drape spent a
-/// fifth longer in these filters.
+/// into: with an iterator adapter on each path it is not, and the filters, run on every
+/// pair every step, are slower.
 fn filter_in_order<T: Sync, U: Send>(items: &[T], parallel: bool, keep: impl Fn(usize, &T) -> Option<U> + Sync) -> Vec<U> {
     use rayon::prelude::*;
     const CHUNK: usize = 4096;

@@ -115,9 +115,8 @@ impl StepContacts {
                 // λF(s) of the slip s = |u_T|: curvature λF'(s)/s across the slip and λF''(s)
                 // along it. Sticking (s ≤ ε), F is quadratic and both are μ_s/ε. Sliding,
                 // F'' < 0 as μ decays to μ_k; 0 is used there. λF'(s)/s along the slip would
-                // be up to μ_s/ε·λ: twenty times a resting vertex's inertia at the drape's slip
-                // threshold, and with it Newton creeps along a sliding vertex's path at 0.3 µm
-                // an iteration.
+                // be up to μ_s/ε·λ, many times a resting vertex's inertia at a small slip
+                // threshold, and with it Newton creeps along a sliding vertex's path.
                 let u = y[i] - anchor[i];
                 let t = u - u.dot(c.normal) * c.normal;
                 let slip = t.length();
@@ -149,7 +148,7 @@ impl StepContacts {
     /// Makes prop contact inelastic: a vertex still inside its contact layer at the end of
     /// the step keeps no velocity away from the prop. The penalty is a spring, and BDF2,
     /// which hardly damps, would otherwise give back its energy as a bounce (a dropped
-    /// cloth jumped back to 90 % of its height); cloth does not bounce.
+    /// cloth would jump back up nearly to its height); cloth does not bounce.
     /// Returns the vertices whose velocity changed.
     pub fn absorb_rebound(&self, y: &[DVec3], v: &mut [DVec3]) -> Vec<u32> {
         let mut changed = Vec::new();

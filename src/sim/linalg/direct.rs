@@ -3,8 +3,7 @@
 //!
 //! An incomplete factor leaves out the fill that couples distant vertices, which is what
 //! the stiff bending modes of a fine mesh need: with it the CG iterations grow in
-//! proportion to the vertex count (8 per Newton iteration at 875 triangles, 123 at
-//! 20 000). The complete factor of a recent matrix leaves CG only the change since then
+//! proportion to the vertex count. The complete factor of a recent matrix leaves CG only the change since then
 //! and the contact couplings to resolve. Its pattern (in-plane one-ring, bending stencil,
 //! fixed vertices) is the model's for the whole run, so the ordering and symbolic analysis
 //! are done once and each factorisation is numeric only. faer's symbolic analysis picks
@@ -117,11 +116,12 @@ impl DirectPattern {
     }
 }
 
-/// A factorisation's multiply-adds work on dense supernodal blocks, a solve's read the
-/// factor once each: timed on the 20 000-triangle drape, a factorisation costs about 16 CG
-/// iterations with it, where the multiply-add count says 90. This ratio keeps the cost a
-/// count (the same choice on every machine) but in the right units; without it the
-/// rent-or-buy rule kept factors five times too long.
+/// A factorisation's time over what its multiply-add count says in CG iterations: its
+/// multiply-adds work on dense supernodal blocks, a solve's read the factor once each, so
+/// a factorisation costs far fewer iterations' time than its count says (the ratio was
+/// timed on a fine drape; docs/performance-log.md). It keeps the cost a count (the same
+/// choice on every machine) but in the right units; without it the rent-or-buy rule keeps
+/// factors several times too long.
 const FACTOR_SPEED_RATIO: f64 = 0.2;
 
 /// The Cholesky factor of one Newton matrix.

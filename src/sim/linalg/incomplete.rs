@@ -9,7 +9,7 @@ use glam::{DMat3, DVec3, Mat3};
 /// matrix: the in-plane one-ring and the bending matrix's wider stencil. Leaving the
 /// bending entries out (as a factor on the in-plane pattern does) costs little on coarse
 /// meshes but makes the conjugate gradient's iterations grow like the bending stiffness,
-/// h²·B/ℓ⁴, as the mesh is refined: seven times as many at 5 000 triangles.
+/// h²·B/ℓ⁴, as the mesh is refined.
 ///
 /// Triangular solves are sequential, so a large matrix is factored in parts: contiguous
 /// ranges of vertices (spatially coherent on our meshes) whose couplings to other parts
@@ -58,10 +58,9 @@ impl IncompleteCholesky {
         let count = if n < 2 * PART_VERTICES { 1 } else { n / PART_VERTICES };
         let bounds: Vec<(usize, usize)> = (0..count).map(|p| (p * n / count, (p + 1) * n / count)).collect();
         // The contact couplings' off-diagonal blocks k·c_i c_j·nnᵀ, by row (columns below the
-        // row, ascending, summed). Without them the factor saw each coupled vertex held
-        // on its own where only the pair's relative motion is: a CG iteration per pair was
-        // spent finding that out (17 per Newton iteration on the tablecloth against 7
-        // without self-collision).
+        // row, ascending, summed). Without them the factor sees each coupled vertex held
+        // on its own where only the pair's relative motion is, and CG spends an iteration
+        // per pair finding that out.
         let mut coupled: Vec<Vec<(u32, DMat3)>> = vec![Vec::new(); n];
         for c in a.couplings {
             let nn = DMat3::from_cols(c.normal * c.normal.x, c.normal * c.normal.y, c.normal * c.normal.z) * c.stiffness;

@@ -1,9 +1,8 @@
 //! faer's supernodal Cholesky factor, factored and solved with on two threads.
 //!
 //! faer's own numeric factorisation and solves walk the supernodes one after another, and
-//! on the fine drapes they are what a run waits for: at 20 463 triangles one factorisation
-//! takes 0.15–0.25 s and a solve, which reads the factor's 45 MB twice, about 9 ms.
-//! faer's rayon mode parallelises the dense work inside each supernode, and on these small
+//! on the fine drapes they are what a run waits for: a solve reads the whole factor twice,
+//! and the factor grows faster than the mesh. faer's rayon mode parallelises the dense work inside each supernode, and on these small
 //! supernodes it was slower (see `direct::PARALLELISM`). Here the elimination tree is cut
 //! instead: two groups of disjoint subtrees, of about equal size, are worked at once, one
 //! per thread, and the few supernodes above both (the last separators) after them

@@ -27,8 +27,8 @@ pub struct Coupling {
 
 impl SystemMatrix<'_> {
     pub(super) fn apply(&self, x: &[DVec3], y: &mut [DVec3]) {
-        // One pass over the rows for the three terms: separate passes read and write y
-        // three times, which cost the drape's solves a sixth more time.
+        // One pass over the rows for the three terms: separate passes would read and
+        // write y three times, and the product is bound by memory traffic.
         for_rows(y, |row, out| {
             *out = if self.fixed[row] {
                 DVec3::ZERO

@@ -35,7 +35,8 @@ fn banded_chain(n: usize) -> (BlockCsr, ScalarCsr, Vec<f64>) {
 /// Vertices coupled only by contact (disjoint groups of four, stiffer than their mass,
 /// each along its own normal): with the couplings in its pattern the incomplete factor
 /// has no fill to drop and is exact up to its single-precision storage, so CG converges
-/// at once; a factor that saw only the couplings' diagonal blocks took 356 iterations.
+/// at once; a factor that saw only the couplings' diagonal blocks needs many iterations per
+/// coupled group (docs/performance-log.md).
 #[test]
 fn incomplete_factor_takes_the_contact_couplings_in() {
     let groups = 25;

@@ -280,9 +280,9 @@ pub(super) fn bending_patches(mesh: &Mesh, warp_angle: f64, rigid: &[bool]) -> R
 ///
 /// The fits that give the edge gradients average over a ring or more, so a deflection that
 /// zigzags from vertex to vertex can have nearly flat fits everywhere and almost no bending
-/// energy: on the paper's drape mesh about 7 % of the bending operator's modes are such
-/// oscillations, with under 1 % (down to 0.16 %) of the continuum's stiffness B k⁴ at their
-/// wavenumber, and on square grids a zigzag along the grid has 3 % of it. A compressed sheet
+/// energy: on an irregular mesh a share of the bending operator's modes are such
+/// oscillations, each with a small fraction of the continuum's stiffness B k⁴ at its
+/// wavenumber, and on square grids a zigzag along the grid is as soft. A compressed sheet
 /// buckles into them at the scale of the mesh (hourglass modes, as in under-integrated
 /// finite elements). Each interior edge therefore adds the energy of a hinge, the paper's
 /// cantilever across the edge, acting only on what the fitted curvature does not explain:
@@ -444,9 +444,9 @@ fn quadratic_gradient_weights(points: &[u32], warp: &[DVec2], midpoint: DVec2, s
 /// Inverse of a symmetric positive definite 6×6 matrix by Cholesky; None when a pivot is
 /// below 1e-4 of the largest diagonal entry. Such a fit is nearly ill-posed (its points lie
 /// close to a conic, as happens near corners of irregular meshes): it would still invert,
-/// but with weights so large that the bending matrix gained eigenvalues a million times too
-/// high (explicit steps 100× too small, stiff Newton systems). The caller then grows the
-/// neighbourhood instead.
+/// but with weights so large that the bending matrix gains eigenvalues orders of magnitude
+/// too high (explicit steps far too small, stiff Newton systems). The caller then grows
+/// the neighbourhood instead.
 // Index loops are the plain statement of a 6×6 Cholesky solve.
 #[allow(clippy::needless_range_loop)]
 fn invert_spd6(a: [[f64; 6]; 6]) -> Option<[[f64; 6]; 6]> {

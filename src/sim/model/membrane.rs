@@ -84,10 +84,9 @@ impl Model {
     /// The in-plane stiffness with as much of the compressed edges' (negative) geometric
     /// stiffness as `compressed` lets in.
     ///
-    /// Dropping it all made Newton converge linearly on a buckling cloth, and on the Cusick
-    /// drape at a ratio of 0.5–0.7 per iteration: the dropped term is the softening that
-    /// lets compressed cloth bend out of plane, so every Newton step fell short along the
-    /// buckling modes. A compressed edge's term −(|t|/l)(I − uuᵀ) on its two vertices is at
+    /// Dropping it all makes Newton converge only linearly on a buckling cloth (the Cusick
+    /// drape included): the dropped term is the softening that lets compressed cloth bend
+    /// out of plane, so every Newton step falls short along the buckling modes. A compressed edge's term −(|t|/l)(I − uuᵀ) on its two vertices is at
     /// least −2(|t|/l)(|d_a|² + |d_b|²) in any direction d; scaling the edges at vertex i so
     /// that their 2|t|/l sum to at most `allowance[i]` bounds their total below by
     /// −Σ allowance[i] |d_i|².

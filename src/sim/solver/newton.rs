@@ -177,8 +177,9 @@ impl Integrator {
     /// while Newton converges the step shrinks as the gradient does, so the last full step
     /// scaled by the gradient's decrease predicts it, and the preconditioner (a factor of a
     /// recent Newton matrix) gives it to within that factor's error. True if it was taken
-    /// (Newton has converged); otherwise the iteration goes on as usual. On the paper's
-    /// drape a quarter of all Newton iterations had done nothing but take such a step.
+    /// (Newton has converged); otherwise the iteration goes on as usual. A converging
+    /// Newton solve's last iteration would otherwise be a whole assembly and solve for a
+    /// step under the tolerance.
     fn last_step_from_preconditioner(&self, problem: &NewtonProblem, history: &NewtonHistory, norm: f64, work: &mut NewtonWork, y: &mut [DVec3], watch: &mut Stopwatch) -> bool {
         let (Some(before), Some(full), Some(cached)) = (history.previous_norm, history.previous_full_step, self.preconditioner.as_ref()) else {
             return false;
@@ -216,7 +217,8 @@ impl Integrator {
         // relative residual η the step misses Newton's by about η times its length,
         // which the last step's length scaled by the gradient's decrease predicts.
         // Solving to an error of a tenth of the tolerance is enough; tighter solves
-        // of the last, sub-tolerance step cost a third of the drape's CG iterations.
+        // of the last, sub-tolerance step would spend CG iterations on digits Newton
+        // throws away.
         let floor = match (history.previous_norm, history.previous_step) {
             (Some(before), Some(length)) if length > 0.0 && before > 0.0 => 0.1 * tolerance / (length * norm / before),
             _ => 0.0,
@@ -303,8 +305,8 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
         // minimum; a step towards it (at most EXTRAPOLATION times the full step, short of any
         // cloth–cloth pair and of a tenth of an edge per vertex) is kept if Φ is lower there.
         // On a quadratic Φ with Newton's direction the parabola's minimum is at 1 and nothing
-        // is tried. It fires where Newton creeps in steps of a few µm on fine meshes, and
-        // never on the coarse scenes.
+        // is tried. It is meant for fine meshes, where Newton can otherwise creep in tiny
+        // steps along the soft modes.
         let curvature = 2.0 * (phi - phi0 - slope);
         let best = if curvature > 0.0 { -slope / curvature } else { f64::INFINITY };
         let reach = 0.1 * model.mean_edge_length / length;

@@ -32,23 +32,22 @@ impl Integrator {
     /// returns no descent doubles s (from `MIN_SHIFT`), or sets it to the last shift a
     /// failure needed if that is more; the matrix is factored again only if the kept factor
     /// was made for a smaller shift. After each solve the next iteration tries half the
-    /// shift with the same factor: a shift kept through a step slowed Newton to 30
-    /// iterations on a compressed sheet (`tests/conservation.rs`), where a shift is needed
-    /// for only an iteration or two. The need returns in jumps, from zero to about 3 within
-    /// an iteration on the 20 463-triangle drape, and climbing there by doubling failed 94
-    /// of 214 factorisations over its first 0.3 s; starting from the last need, 16 of 139
-    /// (a sixth fewer CG iterations and less CPU, the same Newton iterations).
+    /// shift with the same factor: a shift kept through a step slows Newton badly on a
+    /// compressed sheet (`tests/conservation.rs`), where a shift is needed for only an
+    /// iteration or two. The need returns in jumps, from zero to a large shift within an
+    /// iteration, so climbing by doubling each time would fail many factorisations;
+    /// starting from the last need fails few.
     ///
     /// Fine meshes do not take the bounded matrix of `CompressedEdges::Within` throughout,
     /// which scales the compressed edges' term at each vertex to at most 90 % of the
     /// inertia. The bound guards against the shortest waves, where a compressed edge's
-    /// softening is largest, and inertia per vertex falls as the edge length squared: on the
-    /// 20 463-triangle drape nearly every free vertex is bounded, most to a fiftieth of its
-    /// softening, so that matrix is wrong in the long waves too and Newton converges
-    /// linearly (steps of a few µm for up to 30 iterations, the gradient not falling). The
-    /// exact matrix is positive definite in most of those iterations, and a shift makes it
-    /// so in most of the rest. Over the first 0.3 s of that drape: 1110 Newton iterations
-    /// with the bound, 781 with shifts of at most 0.4, 566 with at most 6.4.
+    /// softening is largest, and inertia per vertex falls as the edge length squared: on a
+    /// fine mesh nearly every free vertex is bounded, most to a small part of its
+    /// softening, so that matrix is wrong in the long waves too and Newton converges only
+    /// linearly (tiny steps, the gradient not falling). The exact matrix is positive
+    /// definite in most of those iterations, and a shift makes it so in most of the rest,
+    /// so the shifted exact matrix takes fewer Newton iterations (the fine drape's figures
+    /// are in docs/performance-log.md).
     fn solve_shifted(&mut self, exact: &SystemMatrix, positions: &[DVec3], direction: &mut [DVec3], solve: &mut Solve) -> bool {
         let n = exact.fixed.len();
         let mut rebuild = false;
@@ -168,8 +167,9 @@ impl Integrator {
         let mut bounded_ready = false;
         if self.preconditioner_is_stale(n) {
             // Factors are made from the bounded matrix. Made from the exact one, the Euler
-            // strip's onset under BDF2 came 4.1 % above π²B/L² (1.5 % from the bounded one;
-            // the test allows 3 %): near the bifurcation the exact matrix is nearly singular,
+            // strip's buckling onset under BDF2 came late, beyond the onset test's
+            // tolerance, where the bounded one's is within it: near the bifurcation the
+            // exact matrix is nearly singular,
             // its incomplete factor breaks down and is shifted, and Newton's steps along the
             // soft mode likely fell below the tolerance while the mode lagged.
             problem.assemble(y, bounded, CompressedEdges::Within(&problem.softening));

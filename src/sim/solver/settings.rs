@@ -21,10 +21,11 @@ pub struct NewtonSettings {
     /// Newton starts from x_n + Δt(2v_n − v_{n−1}), where the last step's acceleration would
     /// carry the cloth, when Φ is lower there than at the inertial guess (the solution is
     /// the same to the Newton tolerance; only the start moves closer to it when the motion
-    /// is smooth). Off by default: it saves 18–20 % of the Newton iterations on the drape,
-    /// Euler buckling and the cantilever but costs 46 % more in shear buckling, and on the
-    /// drape its tolerance-sized differences, amplified by the choice of folds, took the
-    /// scatter of three seeds from 0.040 to 0.054 (README, Speed).
+    /// is smooth). Off by default: it saves Newton iterations where the motion is smooth
+    /// (the drape, Euler buckling, the cantilever) but costs more where it flutters (shear
+    /// buckling's wrinkles), and on the drape its tolerance-sized differences, amplified by
+    /// the choice of folds, widen the scatter of the drape coefficient between random
+    /// seeds (figures in docs/performance-log.md, the morning of 2026-11-30).
     pub warm_start: bool,
     /// The conjugate gradient's preconditioner.
     pub preconditioner: PreconditionerChoice,
@@ -59,11 +60,10 @@ pub(super) enum GlobalPreconditioner {
 }
 
 impl PreconditionerChoice {
-    /// From this many vertices `Auto` takes the complete factor. Measured (CPU seconds per
-    /// simulated second, incomplete against complete): the Cusick drape's first two steps,
-    /// 2.0 and 2.7 at 475 vertices, 31 and 26 at 2737, 498 and 135 at 10 412; its first
-    /// 0.1 s at 5153 vertices, 83 and 40; the whole `tablecloth` run (1681 vertices, much
-    /// contact), 23 and 97.
+    /// From this many vertices `Auto` takes the complete factor. The threshold sits near
+    /// where the drape's measured costs cross, above the size of the contact-heavy
+    /// tablecloth, where the incomplete factor is far cheaper; beyond it the complete factor
+    /// wins by a margin that grows with the mesh (docs/performance-log.md).
     pub const AUTO_CHOLESKY_VERTICES: usize = 3000;
 
     /// The global preconditioner for a mesh of `vertices`, or None for the incomplete factor.

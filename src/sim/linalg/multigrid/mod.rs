@@ -1,9 +1,9 @@
 //! Smoothed-aggregation algebraic multigrid (Vaněk, Mandel and Brezina, 1996) for the
 //! Newton matrix, the conjugate gradient's preconditioner where a scene asks for it
 //! (`solver.newton.preconditioner = "multigrid"`). A V-cycle's cost grows linearly with
-//! the mesh, where a complete factor's fill grows faster; but on the drapes measured, up to
-//! 80 000 triangles, the CG iterations it leaves grow with the mesh too and the complete
-//! factor is 3–9 times faster, so `auto` does not choose it (README, Solvers).
+//! the mesh, where a complete factor's fill grows faster; but the CG iterations it leaves
+//! grow with the mesh too, and on every drape measured the complete factor is faster, so
+//! `auto` does not choose it (docs/solvers.md, Solvers and preconditioners).
 //!
 //! Each level groups its nodes into aggregates (a node and its strongly coupled
 //! neighbours); the coarse space of an aggregate spans its near-null modes, the motions
@@ -39,24 +39,24 @@ const MODES: usize = 6;
 /// A level of this many unknowns or fewer is factored densely.
 const COARSEST_UNKNOWNS: usize = 360;
 
-/// Jacobi sweeps that smooth the tentative prolongator: on the 20 000-triangle drape a
-/// second sweep left as many CG iterations and cost half as much again in time.
+/// Jacobi sweeps that smooth the tentative prolongator: a second sweep leaves as many CG
+/// iterations on the fine drapes and makes the build costlier.
 const PROLONGATOR_SMOOTHING: usize = 1;
 
 /// At most this many levels (the coarsening stalls long before on meshes).
 const MAX_LEVELS: usize = 12;
 
 /// Strength of connection: nodes i and j are coupled strongly when
-/// ‖A_ij‖ ≥ θ √(‖A_ii‖ ‖A_jj‖) (Frobenius norms of the blocks). On the 20 000-triangle
-/// drape θ = 0 (every one-ring neighbour) took a fifth more CG iterations and θ = 0.25
-/// made aggregates too small to coarsen.
+/// ‖A_ij‖ ≥ θ √(‖A_ii‖ ‖A_jj‖) (Frobenius norms of the blocks). θ = 0 (every one-ring
+/// neighbour) leaves more CG iterations on the fine drapes, and θ = 0.25 makes aggregates
+/// too small to coarsen.
 const STRENGTH: f64 = 0.08;
 
 /// Degree of the Chebyshev smoother, and the share of the largest eigenvalue of D⁻¹A
 /// where its interval starts: modes above it are smoothed, those below are left to the
-/// coarse levels. On the 20 000-triangle drape (block Jacobi) degree 3 took a fifth fewer
-/// CG iterations than degree 2 and 5 % less time; a lower end of 0.05 took a quarter fewer
-/// iterations than 0.1.
+/// coarse levels. Degree 3 leaves fewer CG iterations than degree 2 for a little more work
+/// per cycle, and a lower end of 0.05 fewer than 0.1 (the drape's figures are in
+/// docs/performance-log.md).
 const CHEBYSHEV_DEGREE: usize = 3;
 const CHEBYSHEV_LOWER: f64 = 0.05;
 const CHEBYSHEV_UPPER: f64 = 1.1;
@@ -418,10 +418,11 @@ pub struct Multigrid {
     pub sizes: Vec<usize>,
 }
 
-/// A multiply-add in the sparse products' scattered accumulation and the per-aggregate
-/// work costs more than one in a streamed product: timed on the 20 000-triangle drape, a
-/// build took about 20 CG iterations' time, 3.5 times its count. Kept a count, so that the
-/// rent-or-buy choice is the same on every machine.
+/// A build's time over what its multiply-add count says in CG iterations: a multiply-add
+/// in the sparse products' scattered accumulation and the per-aggregate work costs more
+/// than one in a streamed product (the ratio was timed on a fine drape;
+/// docs/performance-log.md). The cost stays a count, so that the rent-or-buy choice is the
+/// same on every machine.
 const SETUP_SPEED_RATIO: f64 = 3.5;
 
 impl Multigrid {
@@ -434,11 +435,10 @@ impl Multigrid {
         // On the finest level, aggregates and the prolongator's smoothing see the in-plane
         // one-ring only (the filtered matrix of smoothed aggregation): the bending stencil
         // is two rings wide, and with it the aggregates, the prolongator's rows and the
-        // Galerkin products grow several times over (setup 1.0–1.2 s instead of 0.3 s on
-        // the 20 000-triangle drape, for 10 % fewer CG iterations). Keeping the bending
-        // entries within the one-ring and lumping the rest into the diagonal took a seventh
-        // fewer there, but the lumped diagonal is negative on irregular meshes (the
-        // fitted stencils' one-ring entries need not be negative).
+        // Galerkin products grow several times over, for a few CG iterations fewer.
+        // Keeping the bending entries within the one-ring and lumping the rest into the
+        // diagonal would save more, but the lumped diagonal is negative on irregular
+        // meshes (the fitted stencils' one-ring entries need not be negative).
         let mut filtered = Some(scalar_matrix(a, false));
         // Translations and rotations about each vertex's own aggregate would be better
         // conditioned; about the centroid of the cloth they span the same space, and the
