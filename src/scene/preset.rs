@@ -29,7 +29,7 @@ pub const SCENES: &[Bundled] = bundled!("";
     "cusick-drape", "cusick-drape-30", "tablecloth");
 
 /// Bundled fabrics.
-pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk", "wool-plain-fast");
+pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk", "wool-plain-fast", "wool-worsted", "wool-flannel", "cotton-poplin", "cotton-oxford", "cotton-lawn", "denim-14oz");
 
 /// Why a preset could not be loaded. Every message names the file and, where it can, the key.
 #[derive(Debug, Error)]
