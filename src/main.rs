@@ -100,6 +100,13 @@ enum FabricAction {
         #[arg(long, value_name = "STANDARD")]
         standard: Option<String>,
     },
+    /// Run the virtual laboratory tests on a fabric and set their readings beside its
+    /// sheet (KES tensile, pure bending, shear, cantilever); exit 5 if any is outside its
+    /// tolerance.
+    Check {
+        /// A bundled fabric's name or a fabric file with sheets.
+        fabric: String,
+    },
     /// List the bundled fabrics and the sheets they come from.
     List,
 }
@@ -126,11 +133,12 @@ struct ScreenshotArgs {
 }
 
 /// Exit codes: 0 done, 2 bad input, 3 the simulation diverged, 4 the screenshot could not
-/// be rendered or written.
+/// be rendered or written, 5 a fabric's virtual tests disagree with its sheet.
 const EXIT_BAD_INPUT: u8 = 2;
 const EXIT_DIVERGED: u8 = 3;
 const EXIT_NO_SCREENSHOT: u8 = 4;
-
+/// `rosette fabric check`: a virtual test read a sheet value outside its tolerance.
+const EXIT_READBACK: u8 = 5;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -234,6 +242,28 @@ fn fabric(action: FabricAction) -> ExitCode {
                 None => {
                     print!("{text}");
                     ExitCode::SUCCESS
+                }
+            }
+        }
+        FabricAction::Check { fabric } => {
+            let loaded = match load_fabric(&fabric) {
+                Ok(f) => f,
+                Err(e) => return bad(&e),
+            };
+            if loaded.sheets.is_empty() {
+                return bad(&format!("{fabric}: no measurement sheet to check against (its keys are written directly)"));
+            }
+            for w in &loaded.warnings {
+                eprintln!("warning: {w}");
+            }
+            match rosette::lab::readback(&loaded.sheets, &loaded.import, &loaded.config) {
+                Ok(r) => {
+                    print!("{}", r.table());
+                    if r.all_pass() { ExitCode::SUCCESS } else { ExitCode::from(EXIT_READBACK) }
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(EXIT_DIVERGED)
                 }
             }
         }
