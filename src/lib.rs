@@ -2,13 +2,17 @@
 //!
 //! `sim` is the physics (no I/O); `scene` turns presets into runnable laboratory tests
 //! with measurements; `render` draws snapshots with wgpu (window and headless); the
-//! `rosette` binary drives scenes from the command line; `reference` holds the analytic
+//! `rosette` binary drives scenes from the command line; `fabric` turns laboratory
+//! measurement sheets (KES-F, FAST, cantilever) into fabrics and `lab` runs the standard
+//! tests on them virtually; `reference` holds the analytic
 //! solutions (elastica, off-axis formulas) the tests and the chart compare against; `chart`
 //! sweeps integrators, time steps and meshes for speed against accuracy; `bench` times
 //! scenes.
 pub mod app;
 pub mod bench;
 pub mod chart;
+pub mod fabric;
+pub mod lab;
 pub mod reference;
 pub mod render;
 pub mod scene;

@@ -55,6 +55,11 @@ enum Command {
     },
     /// List the bundled scenes.
     Presets,
+    /// Fabrics from measurement sheets (KES-F, FAST, ASTM D1388 / BS 3356 cantilever).
+    Fabric {
+        #[command(subcommand)]
+        action: FabricAction,
+    },
     /// Time the paper's Table 1 scenes and the Cusick drape at about 800, 5 000, 20 000
     /// and 80 000 triangles, on 1 and 2 threads; writes bench.csv and bench.json.
     Bench {
@@ -76,6 +81,34 @@ enum Command {
         #[arg(long, value_name = "N")]
         quit_after_frames: Option<u64>,
     },
+}
+
+#[derive(Subcommand)]
+enum FabricAction {
+    /// Convert a sheet (a TOML file with [kes], [fast] and/or [cantilever] sections, or a
+    /// bundled fabric's name) into a fabric file with every value's source.
+    Import {
+        /// The sheet file, or a bundled fabric (see `rosette fabric list`).
+        sheet: String,
+        /// Write the fabric file here (default: standard output).
+        #[arg(long, value_name = "FILE.toml")]
+        out: Option<std::path::PathBuf>,
+    },
+    /// Print a sheet to fill in, every field with its unit and meaning.
+    Template {
+        /// Only this standard's section: kes, fast or cantilever.
+        #[arg(long, value_name = "STANDARD")]
+        standard: Option<String>,
+    },
+    /// Run the virtual laboratory tests on a fabric and set their readings beside its
+    /// sheet (KES tensile, pure bending, shear, cantilever); exit 5 if any is outside its
+    /// tolerance.
+    Check {
+        /// A bundled fabric's name or a fabric file with sheets.
+        fabric: String,
+    },
+    /// List the bundled fabrics and the sheets they come from.
+    List,
 }
 
 /// Rendering the final state offscreen (`rosette run ... --screenshot`).
@@ -100,10 +133,12 @@ struct ScreenshotArgs {
 }
 
 /// Exit codes: 0 done, 2 bad input, 3 the simulation diverged, 4 the screenshot could not
-/// be rendered or written.
+/// be rendered or written, 5 a fabric's virtual tests disagree with its sheet.
 const EXIT_BAD_INPUT: u8 = 2;
 const EXIT_DIVERGED: u8 = 3;
 const EXIT_NO_SCREENSHOT: u8 = 4;
+/// `rosette fabric check`: a virtual test read a sheet value outside its tolerance.
+const EXIT_READBACK: u8 = 5;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -139,9 +174,98 @@ fn main() -> ExitCode {
             }
         },
         Some(Command::Chart { out, quick }) => chart(out, quick),
+        Some(Command::Fabric { action }) => fabric(action),
         Some(Command::Run { preset, overrides, duration, metrics, outline, step_log, screenshot }) => {
             let outputs = RunOutputs { metrics: metrics.as_deref(), outline: outline.as_deref(), step_log: step_log.as_deref() };
             run(&preset, &overrides, duration, &outputs, &screenshot)
+        }
+    }
+}
+
+fn fabric(action: FabricAction) -> ExitCode {
+    use rosette::fabric::{SheetKind, load_fabric, write};
+    let bad = |e: &dyn std::fmt::Display| {
+        eprintln!("error: {e}");
+        ExitCode::from(EXIT_BAD_INPUT)
+    };
+    match action {
+        FabricAction::Template { standard } => {
+            let kind = match standard.as_deref() {
+                None => None,
+                Some(s) => match SheetKind::ALL.into_iter().find(|k| k.section() == s) {
+                    Some(k) => Some(k),
+                    None => return bad(&format!("--standard {s}: use kes, fast or cantilever")),
+                },
+            };
+            print!("{}", write::template(kind));
+            ExitCode::SUCCESS
+        }
+        FabricAction::List => {
+            for b in rosette::scene::preset::FABRICS {
+                match rosette::fabric::parse_fabric(b.text, b.name) {
+                    Ok(f) => {
+                        let sheets: Vec<&str> = f.sheets.sections().map(|s| s.kind.section()).collect();
+                        let from = if sheets.is_empty() { "keys".to_string() } else { sheets.join("+") };
+                        println!("{:<18} {:<16} {}", b.name, from, f.config.description);
+                    }
+                    Err(e) => println!("{:<20} error: {e}", b.name),
+                }
+            }
+            ExitCode::SUCCESS
+        }
+        FabricAction::Import { sheet, out } => {
+            let loaded = match load_fabric(&sheet) {
+                Ok(f) => f,
+                Err(e) => return bad(&e),
+            };
+            if loaded.sheets.is_empty() {
+                return bad(&format!(
+                    "{sheet}: no [kes], [fast] or [cantilever] section to import; `rosette fabric template` prints a sheet to fill in"
+                ));
+            }
+            for w in &loaded.warnings {
+                eprintln!("warning: {w}");
+            }
+            let table = match toml::Table::try_from(&loaded.config) {
+                Ok(t) => t,
+                Err(e) => return bad(&e),
+            };
+            let text = write::fabric_file(&table, &loaded.sheets, &loaded.import, &sheet);
+            match out {
+                Some(path) => match std::fs::write(&path, text) {
+                    Ok(()) => {
+                        eprintln!("wrote {}", path.display());
+                        ExitCode::SUCCESS
+                    }
+                    Err(e) => bad(&format!("cannot write {}: {e}", path.display())),
+                },
+                None => {
+                    print!("{text}");
+                    ExitCode::SUCCESS
+                }
+            }
+        }
+        FabricAction::Check { fabric } => {
+            let loaded = match load_fabric(&fabric) {
+                Ok(f) => f,
+                Err(e) => return bad(&e),
+            };
+            if loaded.sheets.is_empty() {
+                return bad(&format!("{fabric}: no measurement sheet to check against (its keys are written directly)"));
+            }
+            for w in &loaded.warnings {
+                eprintln!("warning: {w}");
+            }
+            match rosette::lab::readback(&loaded.sheets, &loaded.import, &loaded.config) {
+                Ok(r) => {
+                    print!("{}", r.table());
+                    if r.all_pass() { ExitCode::SUCCESS } else { ExitCode::from(EXIT_READBACK) }
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(EXIT_DIVERGED)
+                }
+            }
         }
     }
 }

@@ -20,17 +20,17 @@ pub fn fabric_toml(fabric: &FabricConfig) -> Result<String, String> {
     toml::to_string_pretty(&fabric).map_err(|e| format!("cannot write the fabric as TOML: {e}"))
 }
 
-/// Reads a fabric file (the format of `presets/fabrics/*.toml`) and checks its values.
+/// Reads a fabric file (the format of `presets/fabrics/*.toml`, measurement sheets
+/// included) and checks its values.
 pub fn read_fabric(path: &Path) -> Result<FabricConfig, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    let fabric: FabricConfig = toml::from_str(&text).map_err(|e| format!("{}: {}", path.display(), e.message().trim()))?;
+    let fabric = crate::fabric::parse_fabric(&text, &path.display().to_string()).map_err(|e| e.to_string())?.config;
     if fabric.preset.is_some() {
         return Err(format!(
             "{}: a fabric file opened in the viewer must give every value itself (remove `preset`)",
             path.display()
         ));
     }
-    fabric.to_fabric().map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(fabric)
 }
 

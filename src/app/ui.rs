@@ -292,7 +292,7 @@ impl ViewerUi {
             .show_ui(ui, |ui| {
                 for bundled in FABRICS {
                     if ui.selectable_label(false, bundled.name).clicked() {
-                        match toml::from_str::<FabricConfig>(bundled.text) {
+                        match crate::fabric::parse_fabric(bundled.text, bundled.name).map(|loaded| loaded.config) {
                             Ok(mut f) => {
                                 f.preset = Some(bundled.name.to_string());
                                 *fabric = f;

@@ -29,7 +29,7 @@ pub const SCENES: &[Bundled] = bundled!("";
     "cusick-drape", "cusick-drape-30", "tablecloth");
 
 /// Bundled fabrics.
-pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk");
+pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk", "wool-plain-fast", "wool-worsted", "wool-flannel", "cotton-poplin", "cotton-oxford", "cotton-lawn", "denim-14oz");
 
 /// Why a preset could not be loaded. Every message names the file and, where it can, the key.
 #[derive(Debug, Error)]
@@ -463,16 +463,18 @@ pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, Stri
         let (path, value) = parse_override(o)?;
         apply_override(&mut table, &path, value).map_err(|m| PresetError::BadOverride { text: o.clone(), message: m })?;
     }
-    let scene_fabric = table.remove("fabric").and_then(|v| v.as_table().cloned()).unwrap_or_default();
-    let mut fabric = match scene_fabric.get("preset").and_then(|v| v.as_str()) {
+    let mut scene_fabric = table.remove("fabric").and_then(|v| v.as_table().cloned()).unwrap_or_default();
+    let mut fabric = match scene_fabric.get("preset").and_then(|v| v.as_str()).map(str::to_string) {
         Some(name) => {
-            let (fabric_text, fabric_file) = read_preset("fabric", name, FABRICS, base.as_deref())?;
+            let (fabric_text, fabric_file) = read_preset("fabric", &name, FABRICS, base.as_deref())?;
             let mut t = parse_table(&fabric_text, &fabric_file)?;
+            crate::fabric::merge_scene_sheets(&mut t, &mut scene_fabric);
+            expand_sheets(&mut t, &fabric_file)?;
             // The fabric file's own fields are checked here so errors name that file.
             t.clone()
                 .try_into::<FabricConfig>()
                 .map_err(|e| PresetError::Invalid { file: fabric_file.clone(), message: describe(&e) })?;
-            t.insert("preset".into(), toml::Value::String(name.to_string()));
+            t.insert("preset".into(), toml::Value::String(name));
             t
         }
         None => toml::Table::new(),
@@ -480,6 +482,8 @@ pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, Stri
     for (k, v) in scene_fabric {
         fabric.insert(k, v);
     }
+    // A scene without a fabric file may carry its own sheets.
+    expand_sheets(&mut fabric, &file)?;
     table.insert("fabric".into(), toml::Value::Table(fabric));
     let mut config: SceneConfig =
         table.try_into().map_err(|e: toml::de::Error| PresetError::Invalid { file: file.clone(), message: describe(&e) })?;
@@ -492,6 +496,17 @@ pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, Stri
     fabric.to_fabric().map_err(|source| PresetError::Fabric { file: file.clone(), source })?;
     check_scene(&config).map_err(|message| PresetError::Invalid { file: file.clone(), message })?;
     Ok((config, file))
+}
+
+/// Turns a fabric table's measurement sheets (`[kes]`, `[fast]`, `[cantilever]`) into
+/// fabric keys (crate::fabric); the defaults it had to use are reported on stderr.
+fn expand_sheets(table: &mut toml::Table, file: &str) -> Result<(), PresetError> {
+    let warnings =
+        crate::fabric::expand_sheets(table).map_err(|e| PresetError::Invalid { file: file.to_string(), message: e.to_string() })?;
+    for w in warnings {
+        eprintln!("warning: {file}: {w}");
+    }
+    Ok(())
 }
 
 /// A toml error as one line, with the key path that failed.
@@ -619,7 +634,8 @@ mod tests {
             load_scene(s.name, &[]).unwrap_or_else(|e| panic!("{}: {e}", s.name));
         }
         for f in FABRICS {
-            let t = parse_table(f.text, f.name).unwrap();
+            let mut t = parse_table(f.text, f.name).unwrap();
+            expand_sheets(&mut t, f.name).unwrap_or_else(|e| panic!("{}: {e}", f.name));
             let c: FabricConfig = t.try_into().unwrap_or_else(|e| panic!("{}: {e}", f.name));
             c.to_fabric().unwrap_or_else(|e| panic!("{}: {e}", f.name));
         }

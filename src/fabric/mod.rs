@@ -1,0 +1,78 @@
+//! Fabrics from measurement sheets: KES-F, FAST and ASTM D1388 / BS 3356 cantilever
+//! results turned into the simulator's fabric keys, each with its source.
+//!
+//! A fabric file may hold `[kes]`, `[fast]` and `[cantilever]` sections instead of (or
+//! beside) the fabric keys; [`expand_sheets`] converts them when the file is loaded. The
+//! conversions use the exact unit factors of [`units`]; the tensile curves are built as
+//! [`tensile`] describes; a measured bias bending length goes through the strip theory of
+//! [`bias`]. `rosette fabric import` writes the converted file with every value's source
+//! ([`write`]); docs/fabric-sheets.md is the user's guide to all of it.
+
+pub mod bias;
+pub mod import;
+pub mod sheet;
+pub mod tensile;
+pub mod units;
+pub mod write;
+
+pub use import::{Derived, Import, derive, expand_sheets, merge_scene_sheets};
+pub use sheet::{SheetError, SheetKind, Sheets};
+
+use crate::scene::preset::{FABRICS, FabricConfig};
+use thiserror::Error;
+
+/// A fabric file read with its sheets: the fabric, and what it came from.
+#[derive(Debug, Clone)]
+pub struct LoadedFabric {
+    /// Where it was read from (`presets/fabrics/wool.toml (bundled)` or a path).
+    pub file: String,
+    pub config: FabricConfig,
+    pub sheets: Sheets,
+    /// The keys the sheets gave, with their sources.
+    pub import: Import,
+    /// Defaults used and disagreements found while converting the sheets.
+    pub warnings: Vec<String>,
+}
+
+#[derive(Debug, Error)]
+pub enum LoadError {
+    #[error("cannot read {path}: {source}")]
+    Io { path: String, source: std::io::Error },
+    #[error("no bundled fabric named '{name}' and no such file; bundled fabrics: {available}")]
+    Unknown { name: String, available: String },
+    #[error("{file}: not valid TOML: {message}")]
+    Syntax { file: String, message: String },
+    #[error("{file}: {source}")]
+    Sheet { file: String, source: Box<SheetError> },
+    #[error("{file}: {message}")]
+    Invalid { file: String, message: String },
+}
+
+/// Reads a fabric file's text: sheets converted, keys checked.
+pub fn parse_fabric(text: &str, file: &str) -> Result<LoadedFabric, LoadError> {
+    let sheet_error = |source| LoadError::Sheet { file: file.into(), source: Box::new(source) };
+    let mut table: toml::Table =
+        text.parse().map_err(|e: toml::de::Error| LoadError::Syntax { file: file.into(), message: e.message().trim().into() })?;
+    let sheets = Sheets::take(&mut table).map_err(sheet_error)?;
+    let import = if sheets.is_empty() { Import::default() } else { derive(&sheets, &table).map_err(sheet_error)? };
+    let warnings = import::apply(&mut table, &import);
+    let config: FabricConfig =
+        table.try_into().map_err(|e: toml::de::Error| LoadError::Invalid { file: file.into(), message: e.message().trim().into() })?;
+    config.to_fabric().map_err(|e| LoadError::Invalid { file: file.into(), message: e.to_string() })?;
+    Ok(LoadedFabric { file: file.into(), config, sheets, import, warnings })
+}
+
+/// Loads a bundled fabric by name (`wool`) or a fabric file by path.
+pub fn load_fabric(spec: &str) -> Result<LoadedFabric, LoadError> {
+    let is_path = spec.contains('/') || spec.contains('\\') || spec.ends_with(".toml");
+    if !is_path && let Some(b) = FABRICS.iter().find(|b| b.name == spec) {
+        return parse_fabric(b.text, &format!("presets/fabrics/{}.toml (bundled)", b.name));
+    }
+    let path = std::path::Path::new(spec);
+    if !path.exists() && !is_path {
+        let available = FABRICS.iter().map(|b| b.name).collect::<Vec<_>>().join(", ");
+        return Err(LoadError::Unknown { name: spec.into(), available });
+    }
+    let text = std::fs::read_to_string(path).map_err(|source| LoadError::Io { path: spec.into(), source })?;
+    parse_fabric(&text, spec)
+}
