@@ -7,11 +7,12 @@ pub mod props;
 pub mod rigs;
 pub mod run;
 pub mod strip;
+pub mod validate;
 
 pub use preset::{SceneConfig, SceneKind, load_scene};
 pub use run::{Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
 
-use crate::sim::contact::{ContactModel, ContactSettings};
+use crate::sim::contact::ContactModel;
 use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -44,12 +45,7 @@ pub const GRAVITY: f64 = 9.81;
 
 impl Scene {
     pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
-        let fabric = if config.physics.compression_buckling {
-            config.fabric.with_compression_buckling(config.mesh.edge_length).to_fabric()
-        } else {
-            config.fabric.to_fabric()
-        }
-        .map_err(ModelError::from)?;
+        let fabric = config.material().map_err(ModelError::from)?;
         let props = props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
         let options = PhysicsOptions {
             membrane: config.physics.membrane,
@@ -80,17 +76,7 @@ impl Scene {
             }
         }
         if !props.is_empty() || config.contact.self_collision {
-            let k = &config.contact;
-            let settings = ContactSettings {
-                thickness: k.thickness,
-                friction_static: k.friction_static,
-                friction_kinetic: k.friction_kinetic,
-                self_collision: k.self_collision,
-                self_thickness: k.self_thickness.unwrap_or(k.thickness.min(0.2 * model.mean_edge_length)),
-                stiffness: k.stiffness,
-                slip_speed: k.slip_speed,
-            };
-            model.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
+            model.contact = Some(ContactModel::new(props.clone(), config.contact).map_err(SceneError::Setup)?);
         }
         let mut integrator = Integrator::new(config.solver.integrator, config.solver.dt);
         integrator.newton = config.solver.newton;

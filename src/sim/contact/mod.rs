@@ -41,30 +41,36 @@
 pub mod geometry;
 pub mod props;
 
-pub use props::{Prop, PropError, PropShape, SurfacePoint};
+pub use props::{MAX_REACH, Prop, PropError, PropShape, SurfacePoint};
 
 use crate::sim::model::Model;
 use crate::sim::sparse::{BlockCsr, Coupling};
 use geometry::{SpatialHash, closest_point_triangle, closest_points_segments, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
 use glam::{DMat3, DVec3};
+use serde::{Deserialize, Serialize};
 use std::sync::Mutex;
 
-/// Contact parameters, SI units.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Contact parameters, SI units: the `[contact]` section of a scene file.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct ContactSettings {
-    /// Distance the cloth keeps from props, m.
+    /// Distance the cloth keeps from a prop's surface, m.
     pub thickness: f64,
-    /// Coulomb coefficient while sticking.
+    /// Coulomb friction coefficient while sticking.
     pub friction_static: f64,
-    /// Coulomb coefficient while sliding.
+    /// Coulomb friction coefficient while sliding (at most the static one).
     pub friction_kinetic: f64,
-    /// Cloth–cloth contact on or off.
+    /// Cloth–cloth contact in folds. Off where the cloth cannot touch itself.
     pub self_collision: bool,
-    /// Distance kept between cloth layers, m.
-    pub self_thickness: f64,
-    /// Penalty stiffness as a multiple of m/h² (implicit integrators).
+    /// Distance kept between cloth layers, m; absent: the smaller of the prop thickness
+    /// and a fifth of the mean edge length (`self_thickness_for`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub self_thickness: Option<f64>,
+    /// Contact penalty stiffness as a multiple of m/Δt² per vertex (implicit solvers).
     pub stiffness: f64,
-    /// Tangential speed below which friction sticks, m/s.
+    /// Tangential speed below which friction sticks, m/s. Smoothed (IPC) friction lets a
+    /// sticking cloth under a sideways pull F creep at slip_speed·F/(μN): keep it well
+    /// below the speeds a scene should resolve, and below its settle speed.
     pub slip_speed: f64,
 }
 
@@ -75,7 +81,7 @@ impl Default for ContactSettings {
             friction_static: 0.5,
             friction_kinetic: 0.4,
             self_collision: false,
-            self_thickness: 0.001,
+            self_thickness: None,
             stiffness: 100.0,
             slip_speed: 1e-3,
         }
@@ -83,14 +89,23 @@ impl Default for ContactSettings {
 }
 
 impl ContactSettings {
+    /// The distance kept between cloth layers on a mesh of this mean edge length, m.
+    pub fn self_thickness_for(&self, mean_edge_length: f64) -> f64 {
+        self.self_thickness.unwrap_or(self.thickness.min(0.2 * mean_edge_length))
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         let positive = |key: &str, v: f64| if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("contact.{key} must be positive, got {v}")) };
         positive("thickness", self.thickness)?;
-        positive("self_thickness", self.self_thickness)?;
+        if let Some(v) = self.self_thickness {
+            positive("self_thickness", v)?;
+        }
         positive("stiffness", self.stiffness)?;
         positive("slip_speed", self.slip_speed)?;
-        if !(self.friction_static >= 0.0 && self.friction_kinetic >= 0.0 && self.friction_static.is_finite()) {
-            return Err("contact.friction_static and contact.friction_kinetic must be zero or positive".into());
+        for (key, v) in [("friction_static", self.friction_static), ("friction_kinetic", self.friction_kinetic)] {
+            if !(v >= 0.0 && v.is_finite()) {
+                return Err(format!("contact.{key} must be zero or positive, got {v}"));
+            }
         }
         if self.friction_kinetic > self.friction_static {
             return Err(format!(
@@ -285,7 +300,7 @@ impl ContactModel {
             mu_static: s.friction_static,
             mu_kinetic: s.friction_kinetic,
             thickness: s.thickness,
-            self_thickness: s.self_thickness,
+            self_thickness: s.self_thickness_for(model.mean_edge_length),
             slip: s.slip_speed * h,
         };
         let per_vertex = filter_in_order(start, parallel, |v, _| {
@@ -422,7 +437,7 @@ impl ContactModel {
     fn self_pairs(&self, model: &Model, start: &[DVec3], predicted: &[DVec3], h: f64) -> Vec<SelfPair> {
         let (fixed, mass, triangles, edges) = (&model.fixed, &model.mass, &model.triangles, &model.edges);
         let parallel = triangles.len() >= PARALLEL_TRIANGLES;
-        let delta = self.settings.self_thickness;
+        let delta = self.settings.self_thickness_for(model.mean_edge_length);
         let motion: Vec<f64> = start.iter().zip(predicted).map(|(a, b)| a.distance(*b)).collect();
         let near = self.near_pairs(model, start, motion.iter().copied().fold(0.0, f64::max), delta);
         let stiffness = |m: f64| self.settings.stiffness * m / (h * h);
@@ -473,7 +488,7 @@ impl ContactModel {
     pub fn stop_self_crossings(&self, model: &Model, start: &[DVec3], end: &mut [DVec3], v: &mut [DVec3]) -> u64 {
         let (mass, triangles, edges) = (&model.mass, &model.triangles, &model.edges);
         let n = start.len();
-        let eps = 1e-3 * self.settings.self_thickness;
+        let eps = 1e-3 * self.settings.self_thickness_for(model.mean_edge_length);
         let mut zone: Vec<u32> = (0..n as u32).collect();
         fn root(zone: &mut [u32], mut i: u32) -> u32 {
             while zone[i as usize] != i {
@@ -942,7 +957,7 @@ mod tests {
         let mesh = Mesh::rectangle(0.04, 0.02, edge, Pattern::Regular, 0).unwrap();
         let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
         assert_eq!(model.triangles.len() >= PARALLEL_TRIANGLES, edge < 0.001, "{} triangles", model.triangles.len());
-        let settings = ContactSettings { self_collision: true, self_thickness: 0.002, ..Default::default() };
+        let settings = ContactSettings { self_collision: true, self_thickness: Some(0.002), ..Default::default() };
         let contact = ContactModel::new(Vec::new(), settings).unwrap();
         let folded = |p: DVec2, drift: DVec3| {
             // The layers drift apart in opposite directions, as closing pairs would.
@@ -957,7 +972,7 @@ mod tests {
             let contacts = contact.begin_step(&model, &start, &predicted, 0.004);
             let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
             assert_eq!(listed.len(), contacts.pairs.len(), "step {step}: a pair listed twice");
-            assert_eq!(listed, all_pairs(&model, &start, &predicted, settings.self_thickness), "step {step}");
+            assert_eq!(listed, all_pairs(&model, &start, &predicted, 0.002), "step {step}");
             total += listed.len();
         }
         total
