@@ -197,6 +197,14 @@ impl ViewerUi {
                 }
                 _ => {}
             }
+            if snapshot.stats.unconverged_steps > 0 {
+                ui.colored_label(Color32::from_rgb(255, 110, 100), format!("Newton did not converge on {} steps", snapshot.stats.unconverged_steps))
+                    .on_hover_text(format!(
+                        "Their last Newton step reached {:.1e} of an edge, above the tolerance: their results are not trustworthy. \
+                         Raise solver.newton.max_iterations or take a smaller time step.",
+                        snapshot.stats.worst_residual
+                    ));
+            }
             if snapshot.playing && snapshot.stats.real_time_factor > 0.0 && snapshot.stats.real_time_factor < 0.95 {
                 ui.colored_label(Color32::from_rgb(230, 160, 40), format!("{:.2}× real time", snapshot.stats.real_time_factor));
             }

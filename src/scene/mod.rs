@@ -2,6 +2,7 @@
 //! One registry (`preset::SCENES`) feeds the command line, the tests and the viewer.
 
 pub mod drape;
+pub mod memory;
 pub mod preset;
 pub mod props;
 pub mod rigs;
@@ -57,6 +58,9 @@ impl Scene {
         let warp = c.warp_angle_deg.to_radians();
         let drape = config.scene.kind == SceneKind::Drape;
         let (mesh, clamp_band) = if drape { (drape_mesh(&config)?, 0.0) } else { strip_mesh(&config)? };
+        if let Some(available) = memory::available_bytes() {
+            memory::check(mesh.rest.len(), config.mesh.edge_length, config.solver.newton.preconditioner, available).map_err(SceneError::Setup)?;
+        }
         let mut model = Model::new(&mesh, &fabric, warp, options)?;
         let origin = DVec3::from_array(c.position);
         let mut x: Vec<DVec3> = mesh.rest.iter().map(|p| origin + DVec3::new(p.x, p.y, 0.0)).collect();

@@ -321,11 +321,13 @@ impl Rig {
                 let pivot = line[r.columns.nearest(0.5 * r.length)];
                 let torque: f64 = r.grip.iter().map(|&v| (state.x[v as usize] - pivot).cross(f[v as usize]).y).sum();
                 let moment = torque / r.width;
-                json!({
-                    "curvature": curvature,
-                    "moment": moment,
-                    "rigidity": if curvature > 0.0 { moment / curvature } else { f64::INFINITY },
-                })
+                let mut measures = json!({ "curvature": curvature, "moment": moment });
+                // No rigidity until the strip bends (JSON has no infinity, and null would pass
+                // for a number).
+                if curvature > 0.0 {
+                    measures["rigidity"] = json!(moment / curvature);
+                }
+                measures
             }
             Rig::Euler(r) => {
                 let critical = r.history.iter().find(|h| h.3 > 0.05 * r.length).map(|h| h.2);
@@ -343,8 +345,7 @@ impl Rig {
                         lobe_history.push((h.0, h.4));
                     }
                 }
-                json!({
-                    "critical_load": critical,
+                let mut measures = json!({
                     "critical_load_definition": "end force when the largest normal deflection first exceeds 5 % of the length",
                     "euler_load": r.euler_load(model),
                     "end_force": last.2,
@@ -358,7 +359,12 @@ impl Rig {
                     "quasi_static_force": force_curve(&quasi_static),
                     "dynamic_force": force_curve(&dynamic),
                     "force_history": r.history.iter().step_by((r.history.len() / 100).max(1)).map(|h| json!([h.0, h.1, h.2, h.3])).collect::<Vec<_>>(),
-                })
+                });
+                // Absent until the strip buckles, rather than a null where a number belongs.
+                if let Some(critical) = critical {
+                    measures["critical_load"] = json!(critical);
+                }
+                measures
             }
             Rig::Shear(r) => shear_measures(r, model, state),
             Rig::Drape(r) => {

@@ -232,6 +232,9 @@ pub struct StepReport {
     pub factorizations: usize,
     /// True when Newton stopped at its iteration limit before reaching its tolerance.
     pub newton_unconverged: bool,
+    /// Newton's last step (the largest vertex move) over the mean edge length: below
+    /// `NewtonSettings::tolerance` where Newton converged, 0 for the explicit integrator.
+    pub newton_residual: f64,
     /// Where the step's time went.
     pub timings: StepTimings,
     /// The time step taken, s.
@@ -748,6 +751,7 @@ impl Integrator {
                         }
                     }
                     report.newton_unconverged = false;
+                    previous_step = Some(length);
                     break;
                 }
             }
@@ -926,6 +930,7 @@ impl Integrator {
             }
         }
         report.timings += timings;
+        report.newton_residual = previous_step.map_or(f64::INFINITY, |step| step / model.mean_edge_length);
     }
 }
 
