@@ -8,7 +8,7 @@
 
 use super::preset::{SceneConfig, SceneKind};
 use crate::sim::contact::MAX_REACH;
-use crate::sim::mesh::MAX_VERTICES;
+use crate::sim::mesh::{MAX_VERTICES, planned_vertices};
 
 /// A refused value: its dotted key and why, with the fix.
 #[derive(Debug, Clone, PartialEq)]
@@ -218,11 +218,22 @@ fn check_mesh(c: &SceneConfig, extent: &Extent) -> Result<(), Invalid> {
     }
     // The mesh generators refuse past their vertex cap too, but only after the fabric (whose
     // buckling branch divides by the edge length squared) has been checked.
-    let area = if c.cloth.diameter != 0.0 { std::f64::consts::FRAC_PI_4 * c.cloth.diameter.powi(2) } else { c.cloth.length * c.cloth.width };
-    let vertices = 1.2 * area / (h * h);
-    if vertices > MAX_VERTICES as f64 {
-        let least = 1.001 * (1.2 * area / MAX_VERTICES as f64).sqrt();
-        return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {h:?} m gives about {vertices:.2e} vertices, more than the limit of {MAX_VERTICES}; use at least {least:.3e} m")));
+    let cloth = &c.cloth;
+    let disc = c.scene.kind == SceneKind::Drape && cloth.diameter != 0.0;
+    let planned = |h: f64| {
+        if disc { planned_vertices(cloth.diameter, None, h, c.mesh.pattern) } else { planned_vertices(cloth.length, Some(cloth.width), h, c.mesh.pattern) }
+    };
+    let vertices = planned(h);
+    if vertices > MAX_VERTICES {
+        // The finest edge under the cap, by bisection on its logarithm (the count falls as
+        // the edge grows, and two elements across is far under the cap).
+        let (mut fails, mut passes) = (h, most);
+        for _ in 0..100 {
+            let mid = (fails * passes).sqrt();
+            if planned(mid) > MAX_VERTICES { fails = mid } else { passes = mid }
+        }
+        let least = 1.001 * passes;
+        return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {h:?} m gives about {vertices} vertices, more than the limit of {MAX_VERTICES}; use at least {least:.3e} m")));
     }
     Ok(())
 }
