@@ -9,7 +9,16 @@ use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "rosette", version, about = "Woven-fabric simulator and virtual fabric laboratory")]
+#[command(
+    name = "rosette",
+    version,
+    about = "Woven-fabric simulator and virtual fabric laboratory",
+    after_help = "Exit codes: 0 done; 2 bad input, refused before the run; 3 the simulation diverged; \
+                  4 an output could not be rendered or written after the run; 5 the run ended but \
+                  some Newton solves did not converge (metrics: converged = false); 6 the run \
+                  stopped at --max-steps or --max-wall. Metrics, outline and picture are kept for \
+                  3 to 6."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -40,6 +49,13 @@ enum Command {
         /// shift, the cloth's RMS speed, the CPU time so far and the step's time by phase.
         #[arg(long, value_name = "FILE.csv")]
         step_log: Option<std::path::PathBuf>,
+        /// Most steps the run may take (default: the scene's scene.max_steps, 1 000 000): a
+        /// scene that needs more is refused before it starts.
+        #[arg(long, value_name = "N")]
+        max_steps: Option<u64>,
+        /// Wall-clock seconds after which the run stops, keeping what it has (exit 6).
+        #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_MAX_WALL)]
+        max_wall: f64,
         #[command(flatten)]
         screenshot: ScreenshotArgs,
     },
@@ -101,7 +117,7 @@ enum FabricAction {
         standard: Option<String>,
     },
     /// Run the virtual laboratory tests on a fabric and set their readings beside its
-    /// sheet (KES tensile, pure bending, shear, cantilever); exit 5 if any is outside its
+    /// sheet (KES tensile, pure bending, shear, cantilever); exit 7 if any is outside its
     /// tolerance.
     Check {
         /// A bundled fabric's name or a fabric file with sheets.
@@ -132,13 +148,20 @@ struct ScreenshotArgs {
     wireframe: bool,
 }
 
-/// Exit codes: 0 done, 2 bad input, 3 the simulation diverged, 4 the screenshot could not
-/// be rendered or written, 5 a fabric's virtual tests disagree with its sheet.
+/// Exit codes (also in `--help` and the README): 0 done, 2 bad input (refused before the
+/// run), 3 the simulation diverged, 4 an output could not be rendered or written after the
+/// run, 5 the run ended but some Newton solves did not converge, 6 the run stopped at its
+/// step or wall-time bound, 7 a fabric's virtual tests disagree with its sheet.
 const EXIT_BAD_INPUT: u8 = 2;
 const EXIT_DIVERGED: u8 = 3;
-const EXIT_NO_SCREENSHOT: u8 = 4;
+const EXIT_NO_OUTPUT: u8 = 4;
+const EXIT_NOT_CONVERGED: u8 = 5;
+const EXIT_STOPPED: u8 = 6;
 /// `rosette fabric check`: a virtual test read a sheet value outside its tolerance.
-const EXIT_READBACK: u8 = 5;
+const EXIT_READBACK: u8 = 7;
+
+/// A day: longer than any bundled scene takes, short enough that a runaway run ends.
+const DEFAULT_MAX_WALL: f64 = 86_400.0;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -154,7 +177,7 @@ fn main() -> ExitCode {
                 colormap: None,
                 wireframe: false,
             };
-            let code = run("cusick-drape", &[], None, &RunOutputs::default(), &shot);
+            let code = run("cusick-drape", &[], &RunLimits::default(), &RunOutputs::default(), &shot);
             eprintln!("wrote cusick-drape.png; `rosette run PRESET --screenshot FILE.png` for other scenes");
             code
         }
@@ -175,9 +198,9 @@ fn main() -> ExitCode {
         },
         Some(Command::Chart { out, quick }) => chart(out, quick),
         Some(Command::Fabric { action }) => fabric(action),
-        Some(Command::Run { preset, overrides, duration, metrics, outline, step_log, screenshot }) => {
+        Some(Command::Run { preset, overrides, duration, metrics, outline, step_log, max_steps, max_wall, screenshot }) => {
             let outputs = RunOutputs { metrics: metrics.as_deref(), outline: outline.as_deref(), step_log: step_log.as_deref() };
-            run(&preset, &overrides, duration, &outputs, &screenshot)
+            run(&preset, &overrides, &RunLimits { duration, max_steps, max_wall }, &outputs, &screenshot)
         }
     }
 }
@@ -307,25 +330,72 @@ struct RunOutputs<'a> {
     step_log: Option<&'a std::path::Path>,
 }
 
-fn run(spec: &str, overrides: &[String], duration: Option<f64>, outputs: &RunOutputs, shot: &ScreenshotArgs) -> ExitCode {
-    let (metrics_out, outline_out) = (outputs.metrics, outputs.outline);
-    let config = match load_scene(spec, overrides) {
-        Ok((config, _)) => config,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(EXIT_BAD_INPUT);
-        }
-    };
-    if let Some(d) = duration.filter(|d| !(d.is_finite() && *d > 0.0)) {
-        eprintln!("error: --duration must be a positive number of seconds, got {d}");
-        return ExitCode::from(EXIT_BAD_INPUT);
+/// How long `rosette run` may go on.
+struct RunLimits {
+    /// Simulated seconds, the scene's own when `None`.
+    duration: Option<f64>,
+    /// Steps, the scene's `scene.max_steps` when `None`.
+    max_steps: Option<u64>,
+    /// Wall-clock seconds.
+    max_wall: f64,
+}
+
+impl Default for RunLimits {
+    fn default() -> Self {
+        Self { duration: None, max_steps: None, max_wall: DEFAULT_MAX_WALL }
     }
+}
+
+fn bad_input(message: impl std::fmt::Display) -> ExitCode {
+    eprintln!("error: {message}");
+    ExitCode::from(EXIT_BAD_INPUT)
+}
+
+fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutputs, shot: &ScreenshotArgs) -> ExitCode {
+    let (metrics_out, outline_out) = (outputs.metrics, outputs.outline);
+    // `--max-steps N` is `--set scene.max_steps=N`, so that the scene's checks see it.
+    let mut overrides = overrides.to_vec();
+    if let Some(n) = limits.max_steps {
+        overrides.push(format!("scene.max_steps={n}"));
+    }
+    let config = match load_scene(spec, &overrides) {
+        Ok((config, _)) => config,
+        Err(e) => return bad_input(e),
+    };
+    if let Some(d) = limits.duration {
+        if !(d.is_finite() && d > 0.0) {
+            return bad_input(format!("--duration must be a positive number of seconds, got {d}"));
+        }
+        if let Err(e) = rosette::scene::validate::check_step_count("--duration", d, config.solver.dt, config.scene.max_steps) {
+            return bad_input(e.message);
+        }
+    }
+    if !(limits.max_wall.is_finite() && limits.max_wall > 0.0) {
+        return bad_input(format!("--max-wall must be a positive number of seconds, got {}", limits.max_wall));
+    }
+    // Everything the run will write is checked before it starts, so that a typo in a path
+    // does not cost the run (or turn its divergence into bad input).
+    if outline_out.is_some() && config.scene.kind != rosette::scene::SceneKind::Drape {
+        return bad_input(format!("--outline: {spec} is not a drape scene; only drape scenes have a shadow outline"));
+    }
+    let paths = [("--metrics", metrics_out.filter(|m| *m != "-").map(std::path::Path::new)), ("--outline", outline_out.map(std::path::Path::new)), ("--screenshot", shot.screenshot.as_deref())];
+    for (option, path) in paths {
+        if let Some(Err(e)) = path.map(|p| check_writable(option, p)) {
+            return bad_input(format!("{e:#}"));
+        }
+    }
+    if let Some(path) = shot.screenshot.as_deref().filter(|p| !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))) {
+        return bad_input(format!("--screenshot {}: the picture is written as PNG; name the file FILE.png", path.display()));
+    }
+    // The step log is opened before the run, so that a bad path fails at once, and
+    // written as the run goes, so that a run stopped early keeps its rows.
+    let mut step_log = match outputs.step_log.map(open_step_log).transpose() {
+        Ok(log) => log,
+        Err(e) => return bad_input(format!("{e:#}")),
+    };
     let mut scene = match Scene::build(config) {
         Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {spec}: {e}");
-            return ExitCode::from(EXIT_BAD_INPUT);
-        }
+        Err(e) => return bad_input(format!("{spec}: {e}")),
     };
     let name = std::path::Path::new(spec).file_stem().map_or(spec.to_string(), |s| s.to_string_lossy().into_owned());
     // A progress bar only where someone watches, and only if the run lasts.
@@ -349,40 +419,40 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, outputs: &RunOut
             bar.set_position((fraction * 1000.0) as u64);
         }
     };
-    // The step log is opened before the run, so that a bad path fails at once, and
-    // written as the run goes, so that a run stopped early keeps its rows.
-    let mut step_log = match outputs.step_log.map(open_step_log).transpose() {
-        Ok(log) => log,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            return ExitCode::from(EXIT_BAD_INPUT);
-        }
-    };
     let mut log_error: Option<std::io::Error> = None;
     let mut on_step = |record: &StepRecord| {
         if let (Some(out), None) = (step_log.as_mut(), &log_error) {
             log_error = writeln!(out, "{}", record.csv_row()).err();
         }
     };
-    let options = RunOptions { duration, progress: Some(&mut on_progress), on_step: Some(&mut on_step) };
+    let options = RunOptions {
+        duration: limits.duration,
+        progress: Some(&mut on_progress),
+        on_step: Some(&mut on_step),
+        max_steps: None,
+        max_wall_seconds: Some(limits.max_wall),
+    };
     let (metrics, error) = run_scene(&mut scene, &name, options);
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
-    if let Err(e) = write_metrics(&metrics, metrics_out) {
+    // Every output is attempted, whatever failed before it: the run's results are kept.
+    let mut output_failed = false;
+    let mut fail = |e: anyhow::Error| {
         eprintln!("error: {e:#}");
-        return ExitCode::from(EXIT_BAD_INPUT);
+        output_failed = true;
+    };
+    if let Err(e) = write_metrics(&metrics, metrics_out) {
+        fail(e);
     }
     if let Some(Err(e)) = outline_out.map(|path| write_outline(&scene, path)) {
-        eprintln!("error: {e:#}");
-        return ExitCode::from(EXIT_BAD_INPUT);
+        fail(e);
     }
     // Checked once the run's metrics are saved: a log that fails mid-run (a full disk)
     // does not cost the run's results.
     if let Some(e) = log_error.or_else(|| step_log.as_mut().and_then(|out| out.flush().err())) {
         let path = outputs.step_log.expect("a log was written").display();
-        eprintln!("error: cannot write the step log to {path}: {e}");
-        return ExitCode::from(EXIT_BAD_INPUT);
+        fail(anyhow::anyhow!("cannot write the step log to {path}: {e}"));
     }
     if metrics_out.is_none() {
         eprintln!(
@@ -395,17 +465,50 @@ fn run(spec: &str, overrides: &[String], duration: Option<f64>, outputs: &RunOut
         // The last good state, also after a divergence.
         let options = render::Screenshot { path: path.clone(), size: shot.size, view: shot.camera, color_map: shot.colormap, wireframe: shot.wireframe };
         if let Err(e) = render::save_screenshot(&scene, &options) {
-            eprintln!("error: screenshot: {e}");
-            return ExitCode::from(EXIT_NO_SCREENSHOT);
+            fail(anyhow::anyhow!("screenshot: {e}"));
         }
     }
-    match error {
-        Some(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(EXIT_DIVERGED)
-        }
-        None => ExitCode::SUCCESS,
+    // The run's own outcome first: a diverged, cut-short or unconverged run is what the
+    // caller most needs to know; an output that failed is said above.
+    if let Some(e) = error {
+        eprintln!("error: {e}");
+        return ExitCode::from(EXIT_DIVERGED);
     }
+    if let Some(reason) = &metrics.stopped_at_limit {
+        eprintln!("error: {name}: {reason}; the results cover {:.4} s", metrics.simulated_seconds);
+        return ExitCode::from(EXIT_STOPPED);
+    }
+    if !metrics.converged {
+        eprintln!(
+            "error: {name}: Newton did not converge on {} steps (its last step reached {:.2e} of an edge, the tolerance is {:.0e}): \
+             the results are not trustworthy; raise solver.newton.max_iterations or use a smaller solver.dt",
+            metrics.newton_limit_steps, metrics.worst_residual, scene.integrator.newton.tolerance
+        );
+        return ExitCode::from(EXIT_NOT_CONVERGED);
+    }
+    if output_failed {
+        return ExitCode::from(EXIT_NO_OUTPUT);
+    }
+    ExitCode::SUCCESS
+}
+
+/// Checks before a run that `path` can be written: a file can be created there (and is
+/// removed again if it was not there before), or the file that is there can be opened for
+/// writing, without truncating it.
+fn check_writable(option: &str, path: &std::path::Path) -> anyhow::Result<()> {
+    if path.is_dir() {
+        anyhow::bail!("{option} {}: is a folder; give a file name", path.display());
+    }
+    let existed = path.exists();
+    std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(path)
+        .with_context(|| format!("{option} {}: cannot write there", path.display()))?;
+    if !existed {
+        std::fs::remove_file(path).ok();
+    }
+    Ok(())
 }
 
 /// Creates the step log and writes its header.

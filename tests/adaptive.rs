@@ -64,7 +64,7 @@ fn adaptive_cantilever_matches_the_elastica_in_fewer_steps() {
     };
     let (config, fixed) = run(&[]);
     let (_, adaptive) = run(&["solver.adaptive.tolerance=2e-5", "solver.adaptive.dt_max=0.05"]);
-    let f = &config.fabric;
+    let f = &config.fabric.properties;
     let length = config.cloth.length;
     let lambda = f.areal_density * GRAVITY * length.powi(3) / f.bending_warp;
     let exact = heavy_cantilever(lambda).tip_drop_over_l;

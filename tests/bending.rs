@@ -17,7 +17,7 @@ fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Measures) {
 
 /// B_θ of paper eq. 3 from the fabric's inputs, with θ the bending direction from the warp.
 fn rigidity(config: &SceneConfig, theta_deg: f64) -> f64 {
-    let f = &config.fabric;
+    let f = &config.fabric.properties;
     let middle = match f.bending_bias {
         Some(bias) => 4.0 * bias - f.bending_warp - f.bending_weft,
         // 2ν B_x + 4 G_Pa h³/12 with G_Pa = G / h.
@@ -98,7 +98,7 @@ fn arc_rigidity_off_axis_converges_to_b_theta_as_the_edge_layers_shrink() {
 fn cantilever_check(patterns: &[&str], warps: &[f64], fabric: &[&str]) {
     let fabric: Vec<String> = fabric.iter().map(|s| s.to_string()).collect();
     let (base, _) = load_scene("cantilever", &fabric).unwrap();
-    let w = base.fabric.areal_density * rosette::scene::GRAVITY;
+    let w = base.fabric.properties.areal_density * rosette::scene::GRAVITY;
     for &pattern in patterns {
         for &warp in warps {
             let b = rigidity(&base, -warp);
@@ -172,7 +172,7 @@ fn bias_cantilever_follows_the_anticlastic_strip_theory() {
     use rosette::lab::{Direction, cantilever_bending_length};
     let (config, _) = load_scene("cantilever", &[]).unwrap();
     let f = config.fabric.to_fabric().unwrap();
-    let b45 = config.fabric.bending_bias.expect("the bundled wool has a bias rigidity");
+    let b45 = config.fabric.properties.bending_bias.expect("the bundled wool has a bias rigidity");
     let w = f.areal_density * 9.80665;
     let axial = rosette::reference::off_axis_modulus(
         f.tensile_warp.initial_slope(),
@@ -211,7 +211,7 @@ fn bias_cantilever_follows_the_anticlastic_strip_theory() {
 #[test]
 fn cantilever_error_shrinks_on_refinement() {
     let (base, _) = load_scene("cantilever", &[]).unwrap();
-    let w = base.fabric.areal_density * rosette::scene::GRAVITY;
+    let w = base.fabric.properties.areal_density * rosette::scene::GRAVITY;
     let length: f64 = (8.0 * rigidity(&base, 0.0) / w).cbrt();
     let exact = heavy_cantilever(8.0);
     let mut errors = Vec::new();
@@ -245,7 +245,7 @@ fn arc_follows_a_nonlinear_moment_curvature_curve() {
             ("mesh.edge_length", "0.003".into()),
         ]),
     );
-    assert_eq!(config.fabric.bending_warp, 9e-6, "the curve's initial slope is the warp rigidity");
+    assert_eq!(config.fabric.properties.bending_warp, 9e-6, "the curve's initial slope is the warp rigidity");
     let m = m.arc().expect("arc measures");
     let kappa = m.curvature;
     // The curve at the measured curvature, interpolated here.

@@ -17,7 +17,7 @@ fn run(preset: &str, overrides: &[&str]) -> (SceneConfig, Measures) {
 
 /// Pinned–pinned Euler load π²B/L² per unit width, B the warp rigidity (the strip's axis).
 fn euler_load(config: &SceneConfig) -> f64 {
-    std::f64::consts::PI.powi(2) * config.fabric.bending_warp / config.cloth.length.powi(2)
+    std::f64::consts::PI.powi(2) * config.fabric.properties.bending_warp / config.cloth.length.powi(2)
 }
 
 /// End conditions: both short ends held on their lines and free to rotate (pinned), long

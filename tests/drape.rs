@@ -31,7 +31,7 @@ fn run_all(preset: &str, sets: Vec<Vec<String>>) -> Vec<(SceneConfig, Metrics)> 
 
 /// Bending length c = (B/w)^(1/3) with B the mean of warp and weft rigidities.
 fn bending_length(c: &SceneConfig) -> f64 {
-    (0.5 * (c.fabric.bending_warp + c.fabric.bending_weft) / (c.fabric.areal_density * 9.81)).cbrt()
+    (0.5 * (c.fabric.properties.bending_warp + c.fabric.properties.bending_weft) / (c.fabric.properties.areal_density * 9.81)).cbrt()
 }
 
 /// Ranges of drape coefficient measured on real fabrics (docs/references.md §7): limp silks
@@ -86,7 +86,7 @@ fn every_fabric_settles_into_clean_folds_above_the_strip_bound() {
 /// The strip bound with the most flexible direction's rigidity, so that no radial strip of
 /// the specimen is stiffer than the one it assumes.
 fn strip_bound(config: &SceneConfig) -> f64 {
-    let f = &config.fabric;
+    let f = &config.fabric.properties;
     // Paper eq. 3's middle term, from the bias rigidity or 2νB_x + G h²/3.
     let mid = match f.bending_bias {
         Some(bias) => 4.0 * bias - f.bending_warp - f.bending_weft,

@@ -57,22 +57,22 @@ RT = 62
 fn kes_sheet_converts_with_the_exact_gram_force_factors() {
     let (f, warnings) = expand(KES_SHEET).unwrap();
     assert!(warnings.is_empty(), "a complete sheet warns of nothing: {warnings:?}");
-    assert!(close(f.areal_density, 13.7 * 1e-6 / 1e-4, 1e-15), "1 mg/cm² = 0.01 kg/m²");
-    assert!(close(f.thickness, 0.314e-3, 1e-15));
-    assert!(close(f.bending_warp, 0.092 * GF * 1e-2, 1e-14), "1 gf·cm²/cm = 9.80665e-5 N·m");
-    assert!(close(f.bending_weft, 0.071 * GF * 1e-2, 1e-14));
+    assert!(close(f.properties.areal_density, 13.7 * 1e-6 / 1e-4, 1e-15), "1 mg/cm² = 0.01 kg/m²");
+    assert!(close(f.properties.thickness, 0.314e-3, 1e-15));
+    assert!(close(f.properties.bending_warp, 0.092 * GF * 1e-2, 1e-14), "1 gf·cm²/cm = 9.80665e-5 N·m");
+    assert!(close(f.properties.bending_weft, 0.071 * GF * 1e-2, 1e-14));
     // Shear: the mean of the two directions, 1 gf/(cm·deg) = 0.980665·180/π N/m per radian.
     let g = 0.5 * (0.70 + 0.74) * (GF / 1e-2) * 180.0 / std::f64::consts::PI;
-    assert!(close(f.shear_modulus, g, 1e-14), "{} vs {g}", f.shear_modulus);
+    assert!(close(f.properties.shear_modulus, g, 1e-14), "{} vs {g}", f.properties.shear_modulus);
     // Tensile: the curve ends at (EMT, 500 gf/cm) and its area is LT·Fm·EMT/2 (WT).
     let fm = 500.0 * GF / 1e-2;
-    for (curve, emt, lt) in [(&f.tensile_warp, 0.06, 0.62), (&f.tensile_weft, 0.075, 0.55)] {
+    for (curve, emt, lt) in [(&f.properties.tensile_warp, 0.06, 0.62), (&f.properties.tensile_weft, 0.075, 0.55)] {
         let end = curve.last().unwrap();
         assert!(close(end[0], emt, 1e-15) && close(end[1], fm, 1e-15), "{curve:?}");
         assert!(close(area(curve), lt * fm * emt / 2.0, 1e-12), "WT = LT·Fm·EMT/2");
     }
     // The sheet's WT (9.3 gf·cm/cm²) agrees with LT·Fm·EMT/2 = 9.3 exactly.
-    assert!(close(area(&f.tensile_warp), 9.3 * GF * 1e-2 / 1e-4, 1e-12));
+    assert!(close(area(&f.properties.tensile_warp), 9.3 * GF * 1e-2 / 1e-4, 1e-12));
 }
 
 #[test]
@@ -94,19 +94,19 @@ fn fast_sheet_converts_bending_lengths_extensions_and_bias_extension() {
     "#;
     let (f, warnings) = expand(text).unwrap();
     assert!(warnings.is_empty(), "{warnings:?}");
-    assert!(close(f.areal_density, 0.168, 1e-15));
+    assert!(close(f.properties.areal_density, 0.168, 1e-15));
     // FAST-2: B = W·g·C³ with W in kg/m² and C in m.
-    assert!(close(f.bending_warp, 0.168 * G0 * 0.015f64.powi(3), 1e-14), "{}", f.bending_warp);
-    assert!(close(f.bending_weft, 5.02e-6, 1e-14));
+    assert!(close(f.properties.bending_warp, 0.168 * G0 * 0.015f64.powi(3), 1e-14), "{}", f.properties.bending_warp);
+    assert!(close(f.properties.bending_weft, 5.02e-6, 1e-14));
     // FAST-3: the points (E, load) at 5, 20 and 100 gf/cm.
     let expected: Vec<[f64; 2]> = [(0.0, 0.0), (0.0067, 5.0), (0.0187, 20.0), (0.046, 100.0)]
         .iter()
         .map(|&(e, gf_cm)| [e, gf_cm * GF / 1e-2])
         .collect();
-    for (got, want) in f.tensile_warp.iter().zip(&expected) {
-        assert!(close(got[0], want[0], 1e-12) && close(got[1], want[1], 1e-12), "{:?} vs {expected:?}", f.tensile_warp);
+    for (got, want) in f.properties.tensile_warp.iter().zip(&expected) {
+        assert!(close(got[0], want[0], 1e-12) && close(got[1], want[1], 1e-12), "{:?} vs {expected:?}", f.properties.tensile_warp);
     }
-    assert!(close(f.shear_modulus, 123.0 / 4.7, 1e-14), "G = 123/EB5");
+    assert!(close(f.properties.shear_modulus, 123.0 / 4.7, 1e-14), "G = 123/EB5");
 }
 
 #[test]
@@ -114,8 +114,8 @@ fn cantilever_overhang_is_twice_the_bending_length() {
     let base = "poisson_warp = 0.15\n[kes]\nEMT = 5\nLT = 0.6\nG = 0.7\nT = 0.4\n[cantilever]\nW = 150\n";
     let (a, _) = expand(&format!("{base}c_warp = 20\nc_weft = 18")).unwrap();
     let (b, _) = expand(&format!("{base}overhang_warp = \"4 cm\"\noverhang_weft = 36")).unwrap();
-    assert!(close(a.bending_warp, 0.150 * G0 * 0.020f64.powi(3), 1e-14));
-    assert!(close(a.bending_warp, b.bending_warp, 1e-14) && close(a.bending_weft, b.bending_weft, 1e-14));
+    assert!(close(a.properties.bending_warp, 0.150 * G0 * 0.020f64.powi(3), 1e-14));
+    assert!(close(a.properties.bending_warp, b.properties.bending_warp, 1e-14) && close(a.properties.bending_weft, b.properties.bending_weft, 1e-14));
 }
 
 #[test]
@@ -125,22 +125,22 @@ fn missing_values_get_stated_defaults_and_a_warning_each() {
     for key in ["thickness", "shear_modulus", "tensile_warp", "tensile_weft", "poisson_warp", "bending_weft"] {
         assert!(joined.contains(key), "no warning for the defaulted {key}: {joined}");
     }
-    assert!(close(f.thickness, 0.120 / 400.0, 1e-12), "mass per area over 400 kg/m³");
-    assert_eq!(f.shear_modulus, 50.0);
-    assert_eq!(f.poisson_warp, 0.15);
-    assert_eq!(f.bending_weft, f.bending_warp, "the only direction given serves for both");
+    assert!(close(f.properties.thickness, 0.120 / 400.0, 1e-12), "mass per area over 400 kg/m³");
+    assert_eq!(f.properties.shear_modulus, 50.0);
+    assert_eq!(f.properties.poisson_warp, 0.15);
+    assert_eq!(f.properties.bending_weft, f.properties.bending_warp, "the only direction given serves for both");
     let fm = 500.0 * GF / 1e-2;
-    assert!(close(area(&f.tensile_warp), 0.65 * fm * 0.05 / 2.0, 1e-12), "EMT 5 %, LT 0.65");
+    assert!(close(area(&f.properties.tensile_warp), 0.65 * fm * 0.05 / 2.0, 1e-12), "EMT 5 %, LT 0.65");
 }
 
 #[test]
 fn a_key_written_in_the_file_wins_over_the_sheet_and_says_so() {
     let (f, warnings) = expand(&format!("bending_warp = 2e-5\n{KES_SHEET}")).unwrap();
-    assert_eq!(f.bending_warp, 2e-5);
+    assert_eq!(f.properties.bending_warp, 2e-5);
     assert!(warnings.iter().any(|w| w.contains("bending_warp") && w.contains("kes.B_warp")), "{warnings:?}");
     // Two sections that disagree: the first (KES) is used and the other named.
     let (f, warnings) = expand(&format!("{KES_SHEET}\n[fast]\nW = 137\nB_warp = 20")).unwrap();
-    assert!(close(f.bending_warp, 0.092 * GF * 1e-2, 1e-14));
+    assert!(close(f.properties.bending_warp, 0.092 * GF * 1e-2, 1e-14));
     assert!(warnings.iter().any(|w| w.contains("fast.B_warp") && w.contains("kes.B_warp")), "{warnings:?}");
 }
 
@@ -216,10 +216,10 @@ fn the_template_imports_as_it_stands() {
 fn scenes_load_sheet_fabrics_and_override_sheet_fields() {
     let (plain, _) = load_scene("cantilever", &["fabric.preset=wool-plain-fast".into()]).unwrap();
     // The sheet gives both B1 = 5.56 µN·m and C1 = 15 mm (W·g·C³ = 5.5604): B is used.
-    assert!(close(plain.fabric.bending_warp, 5.56e-6, 1e-14), "{}", plain.fabric.bending_warp);
-    assert!(close(plain.fabric.shear_modulus, 26.17, 1e-14));
+    assert!(close(plain.fabric.properties.bending_warp, 5.56e-6, 1e-14), "{}", plain.fabric.properties.bending_warp);
+    assert!(close(plain.fabric.properties.shear_modulus, 26.17, 1e-14));
     let (changed, _) = load_scene("cantilever", &["fabric.preset=wool-plain-fast".into(), "fabric.fast.G=20".into()]).unwrap();
-    assert!(close(changed.fabric.shear_modulus, 20.0, 1e-14), "{}", changed.fabric.shear_modulus);
+    assert!(close(changed.fabric.properties.shear_modulus, 20.0, 1e-14), "{}", changed.fabric.properties.shear_modulus);
     let err = load_scene("cantilever", &["fabric.preset=wool-plain-fast".into(), "fabric.fast.E5_warp=9".into()]).unwrap_err();
     assert!(err.to_string().contains("fast.E5_warp"), "{err}");
 }

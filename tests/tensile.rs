@@ -86,8 +86,8 @@ fn worst_curve_error(label: &str, measured: &[[f64; 2]], input: &[[f64; 2]]) -> 
 fn assert_reproduces_input_curve(preset: &str, direction: &str, overrides: &[&str]) -> f64 {
     let (config, metrics) = run(preset, overrides);
     let input = match direction {
-        "warp" => &config.fabric.tensile_warp,
-        "weft" => &config.fabric.tensile_weft,
+        "warp" => &config.fabric.properties.tensile_warp,
+        "weft" => &config.fabric.properties.tensile_weft,
         other => panic!("unknown direction {other}"),
     };
     let label = format!("{preset} ({direction}, {})", config.solver.integrator);
@@ -141,8 +141,8 @@ fn explicit_pull(preset: &str, direction: &str) {
     let (config, _) = load_scene(preset, &[]).unwrap();
     // Explicit stability: the fastest membrane wave, c = √(E_max/ρ_A), must not cross an
     // edge in one step; E_max is the steepest segment of either input curve.
-    let e_max = steepest_slope(&config.fabric.tensile_warp).max(steepest_slope(&config.fabric.tensile_weft));
-    let wave_speed = (e_max / config.fabric.areal_density).sqrt();
+    let e_max = steepest_slope(&config.fabric.properties.tensile_warp).max(steepest_slope(&config.fabric.properties.tensile_weft));
+    let wave_speed = (e_max / config.fabric.properties.areal_density).sqrt();
     let dt = 0.5 * EDGE / wave_speed;
     let max_strain = config.test.max_strain.unwrap();
     // 3 s for 6 % of 0.1 m, against a membrane wave crossing of 0.1/c ≤ 1.2 ms.
@@ -178,7 +178,7 @@ fn many_kneed_curve_from_overrides_is_reproduced() {
     // Slopes 500, 1667, 3300 and 7750 N/m: strictly stiffening, as woven fabrics do.
     let curve = "[[0,0],[0.004,2],[0.01,12],[0.02,45],[0.04,200]]";
     let (config, _) = load_scene("tensile-warp", &[format!("fabric.tensile_warp={curve}")]).unwrap();
-    assert_eq!(config.fabric.tensile_warp, vec![[0.0, 0.0], [0.004, 2.0], [0.01, 12.0], [0.02, 45.0], [0.04, 200.0]]);
+    assert_eq!(config.fabric.properties.tensile_warp, vec![[0.0, 0.0], [0.004, 2.0], [0.01, 12.0], [0.02, 45.0], [0.04, 200.0]]);
     let speed = config.test.speed.unwrap();
     let duration = format!("scene.duration={}", 0.04 * config.cloth.length / speed);
     let set_curve = format!("fabric.tensile_warp={curve}");
@@ -198,7 +198,7 @@ fn warp_pull_poisson_ratio_is_the_input_nu_xy() {
     // preset's 2:1 strip the mid-section reads ν = 0.1454 at 6 % (−3 %; it is 0.1502 up to
     // about 3 % strain); a 4:1 strip puts it out of the grips' reach.
     let (config, metrics) = run("tensile-warp", &["cloth.length=0.2", "scene.duration=12"]);
-    let expected = config.fabric.poisson_warp;
+    let expected = config.fabric.properties.poisson_warp;
     let nu = tensile(&metrics).poisson_ratio;
     eprintln!("poisson ratio at the end of the pull {nu} (input {expected})");
     // 2 %: what remains is the rosette's second-order geometric terms (of order the 6 %
@@ -243,7 +243,7 @@ fn bias_pull(length: f64) -> (f64, f64, f64, f64) {
     ];
     let overrides: Vec<&str> = overrides.iter().map(String::as_str).collect();
     let (config, metrics) = run("tensile-bias", &overrides);
-    let f = &config.fabric;
+    let f = &config.fabric.properties;
     let theta = config.cloth.warp_angle_deg.to_radians();
     assert_eq!(config.cloth.warp_angle_deg, 45.0);
     let e45 = off_axis_modulus(ex, ey, f.shear_modulus, f.poisson_warp, theta);

@@ -171,18 +171,18 @@ fn fabric_change_restarts_and_a_bad_fabric_is_reported() {
     worker.send(Command::Step);
     let before = worker.sync(WAIT);
     let mut fabric = before.config.fabric.clone();
-    fabric.areal_density = -1.0;
+    fabric.properties.areal_density = -1.0;
     worker.send(Command::SetFabric(Box::new(fabric.clone())));
     let rejected = worker.sync(WAIT);
     let error = rejected.error.clone().expect("a negative density is rejected");
     assert!(error.contains("areal_density"), "{error}");
     assert_eq!(rejected.steps, 1, "the running scene is kept");
-    fabric.areal_density = 0.3;
+    fabric.properties.areal_density = 0.3;
     worker.send(Command::SetFabric(Box::new(fabric)));
     let applied = worker.sync(WAIT);
     assert!(applied.error.is_none());
     assert_eq!(applied.steps, 0, "the scene restarts with the new fabric");
-    assert_eq!(applied.config.fabric.areal_density, 0.3);
+    assert_eq!(applied.config.fabric.properties.areal_density, 0.3);
 }
 
 #[test]

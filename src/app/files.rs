@@ -94,14 +94,14 @@ mod tests {
         let path = dir.join("scene.toml");
         std::fs::write(&path, scene_toml(&config).unwrap()).unwrap();
         let (back, _) = load_scene(path.to_str().unwrap(), &[]).unwrap();
-        assert_eq!(back.fabric.areal_density, 0.31);
+        assert_eq!(back.fabric.properties.areal_density, 0.31);
         assert_eq!(scene_toml(&back).unwrap(), scene_toml(&config).unwrap());
 
         let fabric_path = dir.join("fabric.toml");
         std::fs::write(&fabric_path, fabric_toml(&config.fabric).unwrap()).unwrap();
         let fabric = read_fabric(&fabric_path).unwrap();
-        assert_eq!(fabric.tensile_warp, config.fabric.tensile_warp);
-        assert_eq!(fabric.bending_weft, config.fabric.bending_weft);
+        assert_eq!(fabric.properties.tensile_warp, config.fabric.properties.tensile_warp);
+        assert_eq!(fabric.properties.bending_weft, config.fabric.properties.bending_weft);
         std::fs::write(&fabric_path, "areal_density = 0.1\n").unwrap();
         let err = read_fabric(&fabric_path).unwrap_err();
         assert!(err.contains("thickness") || err.contains("missing"), "{err}");

@@ -109,9 +109,9 @@ pub fn test_plot(ui: &mut egui::Ui, snapshot: &Snapshot) -> bool {
         let measured = tensile.stress_strain.clone();
         let angle = config.cloth.warp_angle_deg.rem_euclid(180.0);
         let (reference, label) = if angle.abs() < 1e-9 {
-            (Some(&config.fabric.tensile_warp), "input warp curve")
+            (Some(&config.fabric.properties.tensile_warp), "input warp curve")
         } else if (angle - 90.0).abs() < 1e-9 {
-            (Some(&config.fabric.tensile_weft), "input weft curve")
+            (Some(&config.fabric.properties.tensile_weft), "input weft curve")
         } else {
             (None, "")
         };

@@ -197,6 +197,14 @@ impl ViewerUi {
                 }
                 _ => {}
             }
+            if snapshot.stats.unconverged_steps > 0 {
+                ui.colored_label(Color32::from_rgb(255, 110, 100), format!("Newton did not converge on {} steps", snapshot.stats.unconverged_steps))
+                    .on_hover_text(format!(
+                        "Their last Newton step reached {:.1e} of an edge, above the tolerance: their results are not trustworthy. \
+                         Raise solver.newton.max_iterations or take a smaller time step.",
+                        snapshot.stats.worst_residual
+                    ));
+            }
             if snapshot.playing && snapshot.stats.real_time_factor > 0.0 && snapshot.stats.real_time_factor < 0.95 {
                 ui.colored_label(Color32::from_rgb(230, 160, 40), format!("{:.2}× real time", snapshot.stats.real_time_factor));
             }
@@ -305,21 +313,21 @@ impl ViewerUi {
             });
         // Rigidities are shown in µN·m, the size they come in.
         let micro = |v: &mut f64| *v * 1e6;
-        let (mut bending_warp, mut bending_weft) = (micro(&mut fabric.bending_warp), micro(&mut fabric.bending_weft));
-        let mut bias = fabric.bending_bias.map(|b| b * 1e6);
+        let (mut bending_warp, mut bending_weft) = (micro(&mut fabric.properties.bending_warp), micro(&mut fabric.properties.bending_weft));
+        let mut bias = fabric.properties.bending_bias.map(|b| b * 1e6);
         egui::Grid::new("fabric").num_columns(2).show(ui, |ui| {
             let mut row = |ui: &mut egui::Ui, label: &str, value: &mut f64, suffix: &str, range: std::ops::RangeInclusive<f64>| {
                 ui.label(label);
                 changed |= ui.add(relative_drag(value).range(range).suffix(suffix)).changed();
                 ui.end_row();
             };
-            row(ui, "areal density", &mut fabric.areal_density, " kg/m²", 1e-3..=5.0);
-            row(ui, "thickness", &mut fabric.thickness, " m", 1e-5..=0.01);
-            row(ui, "shear modulus G", &mut fabric.shear_modulus, " N/m", 1e-3..=1e5);
+            row(ui, "areal density", &mut fabric.properties.areal_density, " kg/m²", 1e-3..=5.0);
+            row(ui, "thickness", &mut fabric.properties.thickness, " m", 1e-5..=0.01);
+            row(ui, "shear modulus G", &mut fabric.properties.shear_modulus, " N/m", 1e-3..=1e5);
             row(ui, "bending, warp", &mut bending_warp, " µN·m", 1e-3..=1e4);
             row(ui, "bending, weft", &mut bending_weft, " µN·m", 1e-3..=1e4);
             ui.label("Poisson ν_xy");
-            changed |= ui.add(egui::DragValue::new(&mut fabric.poisson_warp).range(0.0..=0.9).speed(0.005)).changed();
+            changed |= ui.add(egui::DragValue::new(&mut fabric.properties.poisson_warp).range(0.0..=0.9).speed(0.005)).changed();
             ui.end_row();
             let mut has_bias = bias.is_some();
             if ui.checkbox(&mut has_bias, "bending, bias").on_hover_text("Measured 45° rigidity; off: eq. 3 of the paper").changed() {
@@ -331,10 +339,10 @@ impl ViewerUi {
             }
             ui.end_row();
         });
-        fabric.bending_warp = bending_warp * 1e-6;
-        fabric.bending_weft = bending_weft * 1e-6;
-        fabric.bending_bias = bias.map(|b| b * 1e-6);
-        if let Some(curve) = &fabric.bending_curve {
+        fabric.properties.bending_warp = bending_warp * 1e-6;
+        fabric.properties.bending_weft = bending_weft * 1e-6;
+        fabric.properties.bending_bias = bias.map(|b| b * 1e-6);
+        if let Some(curve) = &fabric.properties.bending_curve {
             ui.small(format!("Nonlinear bending: a moment–curvature curve of {} points (edit it in the fabric file).", curve.len()));
         }
         ui.label("Tensile curves (drag points; double-click adds, right-click removes)");
@@ -490,7 +498,7 @@ fn relative_drag(value: &mut f64) -> egui::DragValue<'_> {
 }
 
 fn curve_mut(fabric: &mut FabricConfig, k: usize) -> &mut Vec<[f64; 2]> {
-    if k == 0 { &mut fabric.tensile_warp } else { &mut fabric.tensile_weft }
+    if k == 0 { &mut fabric.properties.tensile_warp } else { &mut fabric.properties.tensile_weft }
 }
 
 /// The warp and weft stress–strain curves as draggable points. Returns whether a curve
@@ -500,7 +508,7 @@ fn curve_editor(ui: &mut egui::Ui, fabric: &mut FabricConfig, dragging: &mut Opt
     const PICK_RADIUS: f32 = 10.0;
     const COLOURS: [Color32; 2] = [Color32::from_rgb(90, 160, 255), Color32::from_rgb(255, 120, 90)];
     let mut changed = false;
-    let curves = [fabric.tensile_warp.clone(), fabric.tensile_weft.clone()];
+    let curves = [fabric.properties.tensile_warp.clone(), fabric.properties.tensile_weft.clone()];
     let plot = Plot::new("fabric_curves")
         .height(200.0)
         .legend(Legend::default())

@@ -90,6 +90,11 @@ pub struct Stats {
     pub newton_iterations: usize,
     /// Conjugate-gradient iterations of the last step.
     pub cg_iterations: usize,
+    /// Steps since the scene started whose Newton solve stopped short of its tolerance (by
+    /// more than `run::UNCONVERGED_FACTOR`), as `rosette run` counts them against exit 5.
+    pub unconverged_steps: u64,
+    /// The largest of those steps' last Newton step over the mean edge length.
+    pub worst_residual: f64,
 }
 
 /// What the worker shows the UI: one consistent picture of the simulation.
@@ -269,6 +274,8 @@ struct WorkerState {
     pace: (Instant, f64),
     timings: VecDeque<StepTiming>,
     last_report: crate::sim::StepReport,
+    /// Unconverged steps since the scene started, and the worst residual among them.
+    unconverged: (u64, f64),
     last_publish: Instant,
     /// Something changed since the last publish.
     dirty: bool,
@@ -299,6 +306,7 @@ impl WorkerState {
             pace: (Instant::now(), 0.0),
             timings: VecDeque::new(),
             last_report: Default::default(),
+            unconverged: (0, 0.0),
             last_publish: Instant::now(),
             dirty: true,
         };
@@ -454,6 +462,7 @@ impl WorkerState {
         self.drag = None;
         self.timings.clear();
         self.last_report = Default::default();
+        self.unconverged = (0, 0.0);
     }
 
     fn set_solver(&mut self, dt: f64, integrator: IntegratorKind) {
@@ -526,6 +535,9 @@ impl WorkerState {
         match result {
             Ok(report) => {
                 self.last_report = report;
+                if report.newton_residual > crate::scene::run::UNCONVERGED_FACTOR * self.scene.integrator.newton.tolerance {
+                    self.unconverged = (self.unconverged.0 + 1, self.unconverged.1.max(report.newton_residual));
+                }
                 self.error = None;
                 let end = Instant::now();
                 self.timings.push_back(StepTiming { start, end, simulated: report.dt, cpu });
@@ -553,6 +565,8 @@ impl WorkerState {
             bending_energy,
             newton_iterations: self.last_report.newton_iterations,
             cg_iterations: self.last_report.cg_iterations,
+            unconverged_steps: self.unconverged.0,
+            worst_residual: self.unconverged.1,
             ..Default::default()
         };
         if let (Some(first), Some(last)) = (self.timings.front(), self.timings.back()) {

@@ -155,8 +155,12 @@ impl Case {
         overrides.push(format!("mesh.edge_length={}", self.edge_length));
         overrides.push(format!("solver.integrator={}", self.integrator.name()));
         overrides.push(format!("solver.dt={dt}"));
+        // An explicit run at a fraction of its stability limit takes as many steps as that
+        // needs (tens of millions on the stiffest maps): the sweep's cases are bounded by
+        // construction, not by the command line's default step bound.
+        overrides.push(format!("scene.max_steps={}", i64::MAX));
         let (mut config, _) = load_scene(self.problem.preset(), &overrides).map_err(|e| e.to_string())?;
-        let f = &mut config.fabric;
+        let f = &mut config.fabric.properties;
         for point in f.tensile_warp.iter_mut().chain(f.tensile_weft.iter_mut()) {
             point[1] *= self.tensile_scale;
         }
@@ -183,7 +187,7 @@ impl Case {
         let probe = Scene::build(self.config(1e-3)?).map_err(|e| e.to_string())?;
         outcome.explicit_limit = explicit_limit(&probe);
         outcome.triangles = probe.model.triangle_count();
-        let f = &probe.config.fabric;
+        let f = &probe.config.fabric.properties;
         let [a, b] = [f.tensile_warp[0], f.tensile_warp[1]];
         outcome.tensile_stiffness = (b[1] - a[1]) / (b[0] - a[0]);
         outcome.bending_stiffness = f.bending_warp;
@@ -233,8 +237,8 @@ fn measure_error(problem: Problem, config: &SceneConfig, measures: &Measures) ->
     match problem {
         Problem::Cantilever => {
             // λ = w L³ / B with B the warp rigidity: the strip is cut along the warp.
-            let weight = config.fabric.areal_density * GRAVITY;
-            let lambda = weight * length.powi(3) / config.fabric.bending_warp;
+            let weight = config.fabric.properties.areal_density * GRAVITY;
+            let lambda = weight * length.powi(3) / config.fabric.properties.bending_warp;
             let exact = heavy_cantilever(lambda).tip_drop_over_l;
             let drop = measures.cantilever().ok_or_else(other_rig)?.tip_drop / length;
             Ok((drop, Some((drop - exact).abs() / exact)))
@@ -247,7 +251,7 @@ fn measure_error(problem: Problem, config: &SceneConfig, measures: &Measures) ->
         }
         Problem::Tensile => {
             let curve = &measures.tensile().ok_or_else(other_rig)?.stress_strain;
-            let input = &config.fabric.tensile_warp;
+            let input = &config.fabric.properties.tensile_warp;
             let mut worst = 0.0f64;
             let mut compared = 0;
             // A point that is not finite (written as null in the metrics) is not compared.

@@ -3,17 +3,19 @@
 
 pub mod drape;
 pub mod measures;
+pub mod memory;
 pub mod preset;
 pub mod props;
 pub mod rigs;
 pub mod run;
 pub mod strip;
+pub mod validate;
 
 pub use measures::Measures;
 pub use preset::{SceneConfig, SceneKind, load_scene};
 pub use run::{ContactEvents, Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
 
-use crate::sim::contact::{ContactModel, ContactSettings};
+use crate::sim::contact::ContactModel;
 use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -46,12 +48,7 @@ pub const GRAVITY: f64 = 9.81;
 
 impl Scene {
     pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
-        let fabric = if config.physics.compression_buckling {
-            config.fabric.with_compression_buckling(config.mesh.edge_length).to_fabric()
-        } else {
-            config.fabric.to_fabric()
-        }
-        .map_err(ModelError::from)?;
+        let fabric = config.material().map_err(ModelError::from)?;
         let props = props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
         let options = PhysicsOptions {
             membrane: config.physics.membrane,
@@ -63,6 +60,9 @@ impl Scene {
         let warp = c.warp_angle_deg.to_radians();
         let drape = config.scene.kind == SceneKind::Drape;
         let (mesh, clamp_band) = if drape { (drape_mesh(&config)?, 0.0) } else { strip_mesh(&config)? };
+        if let Some(available) = memory::available_bytes() {
+            memory::check(mesh.rest.len(), config.mesh.edge_length, config.solver.newton.preconditioner, available).map_err(SceneError::Setup)?;
+        }
         let mut model = Model::new(&mesh, &fabric, warp, options)?;
         let origin = DVec3::from_array(c.position);
         let mut x: Vec<DVec3> = mesh.rest.iter().map(|p| origin + DVec3::new(p.x, p.y, 0.0)).collect();
@@ -82,17 +82,7 @@ impl Scene {
             }
         }
         if !props.is_empty() || config.contact.self_collision {
-            let k = &config.contact;
-            let settings = ContactSettings {
-                thickness: k.thickness,
-                friction_static: k.friction_static,
-                friction_kinetic: k.friction_kinetic,
-                self_collision: k.self_collision,
-                self_thickness: k.self_thickness.unwrap_or(k.thickness.min(0.2 * model.mean_edge_length)),
-                stiffness: k.stiffness,
-                slip_speed: k.slip_speed,
-            };
-            model.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
+            model.contact = Some(ContactModel::new(props.clone(), config.contact).map_err(SceneError::Setup)?);
         }
         let mut integrator = Integrator::new(config.solver.integrator, config.solver.dt);
         integrator.newton = config.solver.newton;

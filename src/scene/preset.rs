@@ -6,8 +6,10 @@
 //! fabric file. Overrides given with `--set KEY=VALUE` are applied to the scene before the
 //! fabric is merged, so they win over both. Unknown keys are errors, so a typo fails loudly.
 
-use crate::sim::{AdaptiveStep, Fabric, FabricError, IntegratorKind, NewtonSettings, Pattern, PiecewiseLinear};
-use serde::{Deserialize, Serialize};
+use crate::sim::contact::ContactSettings;
+use crate::sim::{AdaptiveStep, Fabric, FabricError, FabricPoints, IntegratorKind, NewtonSettings, Pattern};
+use serde::de::{DeserializeSeed, IntoDeserializer, MapAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -44,8 +46,6 @@ pub enum PresetError {
     Unknown { kind: &'static str, name: String, available: String },
     #[error("--set {text}: {message}")]
     BadOverride { text: String, message: String },
-    #[error("{file}: {source}")]
-    Fabric { file: String, source: FabricError },
 }
 
 /// What kind of laboratory test or demo a scene runs.
@@ -82,51 +82,13 @@ pub struct SceneConfig {
     pub test: TestSection,
     /// Contact settings (props, friction, self-collision).
     #[serde(default)]
-    pub contact: ContactSection,
+    pub contact: ContactSettings,
     /// Rigid props: `[[props]]` tables.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub props: Vec<PropConfig>,
     /// Directory of the scene file, for relative asset paths (none for bundled scenes).
     #[serde(skip)]
     pub base_dir: Option<PathBuf>,
-}
-
-/// Contact with props and between folds of the cloth.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ContactSection {
-    /// Distance the cloth keeps from a prop's surface, m.
-    pub thickness: f64,
-    /// Coulomb friction coefficient while sticking.
-    pub friction_static: f64,
-    /// Coulomb friction coefficient while sliding (at most the static one).
-    pub friction_kinetic: f64,
-    /// Cloth–cloth contact in folds. Off where the cloth cannot touch itself.
-    pub self_collision: bool,
-    /// Distance kept between cloth layers, m; absent: the smaller of the prop thickness
-    /// and a fifth of the edge length.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub self_thickness: Option<f64>,
-    /// Contact penalty stiffness as a multiple of m/Δt² per vertex (implicit solvers).
-    pub stiffness: f64,
-    /// Tangential speed below which friction sticks, m/s. Smoothed (IPC) friction lets a
-    /// sticking cloth under a sideways pull F creep at slip_speed·F/(μN): keep it well
-    /// below the speeds a scene should resolve, and below its settle speed.
-    pub slip_speed: f64,
-}
-
-impl Default for ContactSection {
-    fn default() -> Self {
-        Self {
-            thickness: 0.002,
-            friction_static: 0.5,
-            friction_kinetic: 0.4,
-            self_collision: false,
-            self_thickness: None,
-            stiffness: 100.0,
-            slip_speed: 1e-3,
-        }
-    }
 }
 
 /// The kinds of prop a scene can place.
@@ -196,71 +158,103 @@ pub struct SceneSection {
     /// its support does. Absent: full gravity from the start.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gravity_ramp: Option<f64>,
+    /// Most steps a run may take (`rosette run --max-steps`): a scene that needs more is
+    /// refused before it starts, and a run with adaptive steps stops there.
+    #[serde(default = "default_max_steps")]
+    pub max_steps: u64,
 }
 
 fn default_settle_window() -> f64 {
     0.2
 }
 
-/// A fabric as written in a preset: SI units per unit width.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// A million steps: any bundled scene at its step, or an explicit run at 10 µs for 10 s.
+pub const DEFAULT_MAX_STEPS: u64 = 1_000_000;
+
+fn default_max_steps() -> u64 {
+    DEFAULT_MAX_STEPS
+}
+
+/// A fabric as a file gives it: the simulator's properties (SI units per unit width, the
+/// curves as points) with its name, and in a scene the fabric file it starts from.
+#[derive(Debug, Clone)]
 pub struct FabricConfig {
     /// Bundled fabric name or path of the fabric file this one starts from.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub preset: Option<String>,
-    #[serde(default)]
     pub name: String,
-    #[serde(default)]
     pub description: String,
-    /// Mass per unit area, kg/m².
-    pub areal_density: f64,
-    /// Thickness, m.
-    pub thickness: f64,
-    /// Warp tensile curve, [[strain, N/m], ...].
-    pub tensile_warp: Vec<[f64; 2]>,
-    /// Weft tensile curve, [[strain, N/m], ...].
-    pub tensile_weft: Vec<[f64; 2]>,
-    /// In-plane shear modulus, N/m.
-    pub shear_modulus: f64,
-    /// Poisson ratio ν_xy (weft contraction under a warp pull).
-    pub poisson_warp: f64,
-    /// Bending rigidity along the warp, N·m.
-    pub bending_warp: f64,
-    /// Bending rigidity along the weft, N·m.
-    pub bending_weft: f64,
-    /// Rigidity of a 45° strip, N·m; replaces eq. 3's middle term when given.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bending_bias: Option<f64>,
-    /// Nonlinear bending: warp moment–curvature curve, [[1/m, N·m/m], ...]; its shape scales
-    /// the rigidities with curvature. Absent: linear bending.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bending_curve: Option<Vec<[f64; 2]>>,
+    /// The material's properties, each a key of the fabric table.
+    pub properties: FabricPoints,
 }
 
 impl FabricConfig {
     /// Validated material for the simulator.
     pub fn to_fabric(&self) -> Result<Fabric, FabricError> {
-        let curve = |key: &'static str, points: &[[f64; 2]]| {
-            PiecewiseLinear::new_material(points).map_err(|source| FabricError::Curve { key, source })
-        };
-        let fabric = Fabric {
-            areal_density: self.areal_density,
-            thickness: self.thickness,
-            tensile_warp: curve("tensile_warp", &self.tensile_warp)?,
-            tensile_weft: curve("tensile_weft", &self.tensile_weft)?,
-            shear_modulus: self.shear_modulus,
-            poisson_warp: self.poisson_warp,
-            bending_warp: self.bending_warp,
-            bending_weft: self.bending_weft,
-            bending_bias: self.bending_bias,
-            bending_curve: match &self.bending_curve {
-                Some(points) => Some(curve("bending_curve", points)?),
-                None => None,
-            },
-        };
-        fabric.validate()?;
-        Ok(fabric)
+        self.properties.to_fabric()
+    }
+}
+
+/// Written as one table: the names beside the properties.
+impl Serialize for FabricConfig {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Table<'a> {
+            #[serde(skip_serializing_if = "Option::is_none")]
+            preset: &'a Option<String>,
+            name: &'a str,
+            description: &'a str,
+            #[serde(flatten)]
+            properties: &'a FabricPoints,
+        }
+        Table { preset: &self.preset, name: &self.name, description: &self.description, properties: &self.properties }.serialize(serializer)
+    }
+}
+
+/// Read as one table: the three names are taken out as the keys go by and every other key
+/// goes to the properties, so that an error there keeps its key's path (serde's `flatten`
+/// would buffer the table and lose it, and cannot refuse unknown keys).
+impl<'de> Deserialize<'de> for FabricConfig {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Fields;
+        impl<'de> Visitor<'de> for Fields {
+            type Value = FabricConfig;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a table of fabric properties")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<FabricConfig, A::Error> {
+                let mut names = Names::default();
+                let properties = FabricPoints::deserialize(serde::de::value::MapAccessDeserializer::new(WithoutNames { map, names: &mut names }))?;
+                Ok(FabricConfig { preset: names.preset, name: names.name.unwrap_or_default(), description: names.description.unwrap_or_default(), properties })
+            }
+        }
+        #[derive(Default)]
+        struct Names {
+            preset: Option<String>,
+            name: Option<String>,
+            description: Option<String>,
+        }
+        struct WithoutNames<'n, A> {
+            map: A,
+            names: &'n mut Names,
+        }
+        impl<'de, A: MapAccess<'de>> MapAccess<'de> for WithoutNames<'_, A> {
+            type Error = A::Error;
+            fn next_key_seed<K: DeserializeSeed<'de>>(&mut self, seed: K) -> Result<Option<K::Value>, A::Error> {
+                while let Some(key) = self.map.next_key::<String>()? {
+                    match key.as_str() {
+                        "preset" => self.names.preset = Some(self.map.next_value()?),
+                        "name" => self.names.name = Some(self.map.next_value()?),
+                        "description" => self.names.description = Some(self.map.next_value()?),
+                        _ => return seed.deserialize(IntoDeserializer::<A::Error>::into_deserializer(key)).map(Some),
+                    }
+                }
+                Ok(None)
+            }
+            fn next_value_seed<V: DeserializeSeed<'de>>(&mut self, seed: V) -> Result<V::Value, A::Error> {
+                self.map.next_value_seed(seed)
+            }
+        }
+        deserializer.deserialize_map(Fields)
     }
 }
 
@@ -317,39 +311,14 @@ pub struct PhysicsSection {
     pub bending: bool,
     pub membrane: bool,
     /// Sub-element buckling: compressive membrane stress along the warp and the weft is
-    /// capped at the Euler load of one element, π²B/ℓ² (ℓ the edge length), beyond which
-    /// it grows at 1 % of the initial tensile slope. A triangle stands for cloth that would
-    /// have buckled within it; without the cap coarse meshes lock in folds. Only where the
-    /// tensile curves give no compression points of their own.
+    /// capped at the Euler load of one element (`Fabric::with_compression_buckling`). Only
+    /// where the tensile curves give no compression points of their own.
     pub compression_buckling: bool,
 }
 
 impl Default for PhysicsSection {
     fn default() -> Self {
         Self { gravity: true, bending: true, membrane: true, compression_buckling: false }
-    }
-}
-
-impl FabricConfig {
-    /// The tensile curves with the sub-element buckling branch in compression for elements
-    /// of edge length `edge`, m (see [`PhysicsSection::compression_buckling`]).
-    pub fn with_compression_buckling(&self, edge: f64) -> FabricConfig {
-        let mut f = self.clone();
-        let branch = |curve: &mut Vec<[f64; 2]>, rigidity: f64| {
-            if curve.first().is_none_or(|p| p[0] < 0.0) || curve.len() < 2 || curve[1][0] <= 0.0 {
-                return;
-            }
-            let slope = curve[1][1] / curve[1][0];
-            let critical = std::f64::consts::PI.powi(2) * rigidity / (edge * edge);
-            let knee = critical / slope;
-            // Far enough that no cloth gets there: half its length.
-            let far = 0.5f64.max(2.0 * knee);
-            curve.insert(0, [-knee, -critical]);
-            curve.insert(0, [-far, -critical - 0.01 * slope * (far - knee)]);
-        };
-        branch(&mut f.tensile_warp, self.bending_warp);
-        branch(&mut f.tensile_weft, self.bending_weft);
-        f
     }
 }
 
@@ -453,48 +422,149 @@ fn apply_override(table: &mut toml::Table, path: &[String], value: toml::Value) 
     Ok(())
 }
 
+/// Where each value of a scene came from, so that an error names the file or the `--set`
+/// that gave the bad value.
+struct Sources {
+    scene_file: String,
+    /// The fabric file named by `fabric.preset`, and the keys the scene's own `[fabric]`
+    /// table gives (those are the scene file's).
+    fabric_file: Option<String>,
+    scene_fabric_keys: Vec<String>,
+    /// Each `--set` as typed, with its key.
+    overrides: Vec<(Vec<String>, String)>,
+    /// The scene and fabric files' values before the overrides, to quote as an example.
+    original: toml::Table,
+}
+
+impl Sources {
+    /// The file or `--set` a bad value at `key` (dotted, array indices dropped) came from.
+    fn blame(&self, key: &[String]) -> String {
+        let overlaps = |path: &[String]| path.iter().zip(key).all(|(a, b)| a == b);
+        if let Some((_, text)) = self.overrides.iter().rev().find(|(path, _)| overlaps(path)) {
+            return format!("--set {text}");
+        }
+        match (&self.fabric_file, key) {
+            (Some(fabric_file), [section, field, ..]) if section == "fabric" && !self.scene_fabric_keys.contains(field) => fabric_file.clone(),
+            _ => self.scene_file.clone(),
+        }
+    }
+
+    /// The value the files give at `key`, as TOML, if they give one.
+    fn original(&self, key: &[String]) -> Option<String> {
+        let (last, parents) = key.split_last()?;
+        let mut table = &self.original;
+        for part in parents {
+            table = table.get(part)?.as_table()?;
+        }
+        table.get(last).map(|v| v.to_string())
+    }
+
+    fn invalid(&self, key: &[String], message: String) -> PresetError {
+        PresetError::Invalid { file: self.blame(key), message }
+    }
+}
+
+/// A dotted key split into its parts, array indices (`props[0]`) dropped.
+fn key_parts(key: &str) -> Vec<String> {
+    key.split('.').map(|part| part.split('[').next().unwrap_or("").to_string()).filter(|part| !part.is_empty()).collect()
+}
+
+/// serde's message for a value of the wrong type or length, in the words of a scene file,
+/// led by the key.
+fn type_error(key: &str, message: &str, example: Option<String>) -> String {
+    let words = |s: &str| {
+        s.replace("f64", "a number")
+            .replace("floating point", "the number")
+            .replace("u64", "a whole number")
+            .replace("usize", "a whole number")
+            .replace("integer", "the whole number")
+            .replace("string", "the text")
+            .replace("sequence", "an array")
+    };
+    let message = message.trim();
+    // serde's "invalid type: X, expected Y" (and value, length) read as "must be Y, got X".
+    let reworded = ["invalid type: ", "invalid value: ", "invalid length "].iter().find_map(|lead| {
+        let (got, expected) = message.strip_prefix(lead)?.split_once(", expected ")?;
+        let got = if *lead == "invalid length " { format!("{got} values") } else { words(got) };
+        Some(format!("must be {}, got {got}", words(expected)))
+    });
+    let text = match (reworded, key.is_empty()) {
+        (Some(text), false) => format!("{key} {text}"),
+        (None, false) => format!("{key}: {message}"),
+        (Some(text), true) => text,
+        (None, true) => message.to_string(),
+    };
+    match example {
+        Some(example) if !key.is_empty() => format!("{text}; the file has {key} = {example}"),
+        _ => text,
+    }
+}
+
+/// Deserialises `table` as a `T`, an error naming the key that failed (by its path, which
+/// plain serde leaves out).
+fn deserialize_named<T: serde::de::DeserializeOwned>(table: toml::Table) -> Result<T, (Vec<String>, String, String)> {
+    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+        let path = e.path().to_string();
+        let key = if path == "." { String::new() } else { path };
+        (key_parts(&key), key, e.into_inner().message().to_string())
+    })
+}
+
 /// Loads a scene by bundled name or path, applies `overrides` (`KEY=VALUE`), merges its
-/// fabric and checks everything.
+/// fabric and checks everything: a value out of range is refused here, with the file or
+/// the `--set` that gave it, its key and how to fix it.
 pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, String), PresetError> {
     let (text, file) = read_preset("scene", spec, SCENES, None)?;
     let base = if looks_like_path(spec) || Path::new(spec).exists() { Path::new(spec).parent().map(Path::to_path_buf) } else { None };
     let mut table = parse_table(&text, &file)?;
+    let scene_fabric_keys = table.get("fabric").and_then(|v| v.as_table()).map(|t| t.keys().cloned().collect()).unwrap_or_default();
+    let mut sources = Sources { scene_file: file.clone(), fabric_file: None, scene_fabric_keys, overrides: Vec::new(), original: toml::Table::new() };
+    let mut fabric_table = None;
+    // The fabric file named in the scene file, for the original values.
+    if let Some(name) = table.get("fabric").and_then(|f| f.get("preset")).and_then(|v| v.as_str()) {
+        let (fabric_text, fabric_file) = read_preset("fabric", name, FABRICS, base.as_deref())?;
+        fabric_table = Some((name.to_string(), parse_table(&fabric_text, &fabric_file)?, fabric_file));
+    }
+    sources.original = merge_fabric(table.clone(), fabric_table.as_ref().map(|f| f.1.clone()));
     for o in overrides {
         let (path, value) = parse_override(o)?;
         apply_override(&mut table, &path, value).map_err(|m| PresetError::BadOverride { text: o.clone(), message: m })?;
+        sources.overrides.push((path, o.clone()));
     }
-    let mut scene_fabric = table.remove("fabric").and_then(|v| v.as_table().cloned()).unwrap_or_default();
-    let mut fabric = match scene_fabric.get("preset").and_then(|v| v.as_str()).map(str::to_string) {
-        Some(name) => {
-            let (fabric_text, fabric_file) = read_preset("fabric", &name, FABRICS, base.as_deref())?;
-            let mut t = parse_table(&fabric_text, &fabric_file)?;
-            crate::fabric::merge_scene_sheets(&mut t, &mut scene_fabric);
-            expand_sheets(&mut t, &fabric_file)?;
-            // The fabric file's own fields are checked here so errors name that file.
-            t.clone()
-                .try_into::<FabricConfig>()
-                .map_err(|e| PresetError::Invalid { file: fabric_file.clone(), message: describe(&e) })?;
-            t.insert("preset".into(), toml::Value::String(name));
-            t
+    let preset = table.get("fabric").and_then(|f| f.get("preset"));
+    if let Some(preset) = preset {
+        let name = preset.as_str().ok_or_else(|| sources.invalid(&key_parts("fabric.preset"), format!("fabric.preset must be a fabric name or file in quotes, got {preset}")))?;
+        if fabric_table.as_ref().is_none_or(|f| f.0 != name) {
+            let (fabric_text, fabric_file) = read_preset("fabric", name, FABRICS, base.as_deref())?;
+            fabric_table = Some((name.to_string(), parse_table(&fabric_text, &fabric_file)?, fabric_file));
         }
-        None => toml::Table::new(),
-    };
-    for (k, v) in scene_fabric {
-        fabric.insert(k, v);
-    }
-    // A scene without a fabric file may carry its own sheets.
-    expand_sheets(&mut fabric, &file)?;
-    table.insert("fabric".into(), toml::Value::Table(fabric));
-    let mut config: SceneConfig =
-        table.try_into().map_err(|e: toml::de::Error| PresetError::Invalid { file: file.clone(), message: describe(&e) })?;
-    config.base_dir = base;
-    let fabric = if config.physics.compression_buckling {
-        config.fabric.with_compression_buckling(config.mesh.edge_length)
     } else {
-        config.fabric.clone()
-    };
-    fabric.to_fabric().map_err(|source| PresetError::Fabric { file: file.clone(), source })?;
-    check_scene(&config).map_err(|message| PresetError::Invalid { file: file.clone(), message })?;
+        fabric_table = None;
+    }
+    if let Some((_, t, fabric_file)) = &mut fabric_table {
+        // Sheet fields the scene or a `--set` changes are converted with the file's sheet.
+        if let Some(scene_fabric) = table.get_mut("fabric").and_then(|v| v.as_table_mut()) {
+            crate::fabric::merge_scene_sheets(t, scene_fabric);
+        }
+        expand_sheets(t, fabric_file)?;
+        // The fabric file's own fields are checked here so errors name that file.
+        deserialize_named::<FabricConfig>(t.clone()).map_err(|(_, key, message)| {
+            let key = if key.is_empty() { key } else { format!("fabric.{key}") };
+            PresetError::Invalid { file: fabric_file.clone(), message: type_error(&key, &message, None) }
+        })?;
+        sources.fabric_file = Some(fabric_file.clone());
+    }
+    let mut table = merge_fabric(table, fabric_table.map(|f| f.1));
+    // A scene without a fabric file may carry its own sheets.
+    if let Some(fabric) = table.get_mut("fabric").and_then(|v| v.as_table_mut()) {
+        expand_sheets(fabric, &file)?;
+    }
+    let mut config: SceneConfig = deserialize_named(table).map_err(|(parts, key, message)| {
+        let example = sources.original(&parts);
+        sources.invalid(&parts, type_error(&key, &message, example))
+    })?;
+    config.base_dir = base;
+    super::validate::check_scene(&config).map_err(|e| sources.invalid(&key_parts(&e.key), e.message))?;
     Ok((config, file))
 }
 
@@ -509,105 +579,28 @@ fn expand_sheets(table: &mut toml::Table, file: &str) -> Result<(), PresetError>
     Ok(())
 }
 
-/// A toml error as one line, with the key path that failed.
-fn describe(e: &toml::de::Error) -> String {
-    e.message().trim().to_string()
+/// The scene's table with its `[fabric]` keys laid over the fabric file's.
+fn merge_fabric(mut table: toml::Table, fabric_file: Option<toml::Table>) -> toml::Table {
+    let scene_fabric = table.remove("fabric").and_then(|v| v.as_table().cloned()).unwrap_or_default();
+    let mut fabric = fabric_file.unwrap_or_default();
+    let preset = scene_fabric.get("preset").cloned();
+    for (k, v) in scene_fabric {
+        fabric.insert(k, v);
+    }
+    if let Some(p) = preset {
+        fabric.insert("preset".into(), p);
+    }
+    table.insert("fabric".into(), toml::Value::Table(fabric));
+    table
 }
 
-fn check_scene(c: &SceneConfig) -> Result<(), String> {
-    let positive = |key: &str, v: f64| {
-        if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("{key} must be a positive number, got {v}")) }
-    };
-    positive("scene.duration", c.scene.duration)?;
-    positive("scene.settle_window", c.scene.settle_window)?;
-    if let Some(v) = c.scene.settle_speed {
-        positive("scene.settle_speed", v)?;
+impl SceneConfig {
+    /// The scene's material: its fabric, with the sub-element buckling branch for its mesh
+    /// where `physics.compression_buckling` asks for it.
+    pub fn material(&self) -> Result<Fabric, FabricError> {
+        let fabric = self.fabric.to_fabric()?;
+        if self.physics.compression_buckling { fabric.with_compression_buckling(self.mesh.edge_length) } else { Ok(fabric) }
     }
-    if let Some(v) = c.scene.gravity_ramp {
-        positive("scene.gravity_ramp", v)?;
-    }
-    positive("solver.dt", c.solver.dt)?;
-    positive("mesh.edge_length", c.mesh.edge_length)?;
-    if !(c.solver.damping >= 0.0 && c.solver.damping.is_finite()) {
-        return Err(format!("solver.damping must be zero or positive (1/s), got {}", c.solver.damping));
-    }
-    if let Some(a) = c.solver.adaptive.filter(|a| a.enabled) {
-        positive("solver.adaptive.tolerance", a.tolerance)?;
-        positive("solver.adaptive.dt_min", a.dt_min)?;
-        if !(a.dt_min <= c.solver.dt && c.solver.dt <= a.dt_max) {
-            return Err(format!(
-                "solver.dt = {} s must lie between solver.adaptive.dt_min = {} s and dt_max = {} s",
-                c.solver.dt, a.dt_min, a.dt_max
-            ));
-        }
-        if c.solver.integrator.is_explicit() {
-            return Err(format!(
-                "solver.adaptive works with the implicit integrators; {} is stable only below a fixed \
-                 limit: set solver.adaptive.enabled = false or solver.integrator = \"implicit-euler\"",
-                c.solver.integrator
-            ));
-        }
-    }
-    if c.solver.dt > c.scene.duration {
-        return Err(format!("solver.dt = {} s is longer than scene.duration = {} s", c.solver.dt, c.scene.duration));
-    }
-    if !c.cloth.warp_angle_deg.is_finite() {
-        return Err("cloth.warp_angle_deg must be a finite angle in degrees".into());
-    }
-    let need = |key: &str, v: Option<f64>| -> Result<f64, String> {
-        let v = v.ok_or_else(|| format!("{key} is required for a {:?} scene", c.scene.kind))?;
-        positive(key, v)?;
-        Ok(v)
-    };
-    match c.scene.kind {
-        SceneKind::Tensile => {
-            need("test.max_strain", c.test.max_strain)?;
-            need("test.speed", c.test.speed)?;
-        }
-        SceneKind::EulerBuckling => {
-            let s = need("test.end_shortening", c.test.end_shortening)?;
-            if s >= 0.9 {
-                return Err(format!("test.end_shortening = {s} leaves almost no strip; use a fraction below 0.9"));
-            }
-            need("test.speed", c.test.speed)?;
-        }
-        SceneKind::ShearBuckling => {
-            let a = need("test.shear_angle_deg", c.test.shear_angle_deg)?;
-            if a >= 60.0 {
-                return Err(format!("test.shear_angle_deg = {a} is beyond any fabric's locking angle; use less than 60"));
-            }
-            need("test.speed", c.test.speed)?;
-        }
-        SceneKind::Arc => {
-            need("test.curvature", c.test.curvature)?;
-        }
-        SceneKind::Cantilever => {}
-        SceneKind::Drape => {
-            if c.props.is_empty() {
-                return Err("a drape scene needs at least one [[props]] table to drape over".into());
-            }
-            if c.test.support_diameter.is_none() && c.test.support_size.is_none() {
-                return Err("a drape scene needs test.support_diameter (a pedestal) or test.support_size (a table top), m".into());
-            }
-            if let Some(r) = c.test.clamp_radius {
-                positive("test.clamp_radius", r)?;
-            }
-        }
-    }
-    if c.contact.friction_kinetic > c.contact.friction_static || c.contact.friction_kinetic < 0.0 {
-        return Err(format!(
-            "contact.friction_kinetic = {} must lie between 0 and contact.friction_static = {}",
-            c.contact.friction_kinetic, c.contact.friction_static
-        ));
-    }
-    positive("contact.thickness", c.contact.thickness)?;
-    if c.scene.kind == SceneKind::Drape && c.cloth.diameter > 0.0 {
-        return positive("cloth.diameter", c.cloth.diameter);
-    }
-    // Every other scene is a rectangular cloth.
-    positive("cloth.length", c.cloth.length)?;
-    positive("cloth.width", c.cloth.width)?;
-    Ok(())
 }
 
 /// The description line of every bundled scene, for `rosette presets`.
@@ -653,11 +646,11 @@ mod tests {
             ],
         )
         .unwrap();
-        assert_eq!(config.fabric.areal_density, 0.2);
+        assert_eq!(config.fabric.properties.areal_density, 0.2);
         assert_eq!(config.solver.integrator, IntegratorKind::Bdf2);
-        assert_eq!(config.fabric.tensile_warp, vec![[0.0, 0.0], [0.01, 12.5]]);
+        assert_eq!(config.fabric.properties.tensile_warp, vec![[0.0, 0.0], [0.01, 12.5]]);
         assert_eq!(config.fabric.preset.as_deref(), Some("denim"));
-        assert!(config.fabric.bending_warp > 5e-5, "denim's rigidity came with the preset switch");
+        assert!(config.fabric.properties.bending_warp > 5e-5, "denim's rigidity came with the preset switch");
     }
 
     #[test]

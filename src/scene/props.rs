@@ -2,7 +2,7 @@
 //! with OBJ meshes read from the bundled assets or from disk.
 
 use super::preset::{PropConfig, PropKind};
-use crate::sim::contact::{Prop, PropShape};
+use crate::sim::contact::{MAX_REACH, Prop, PropShape};
 use glam::{DQuat, DVec3, EulerRot};
 use std::path::Path;
 
@@ -34,10 +34,10 @@ fn build_prop(index: usize, c: &PropConfig, base_dir: Option<&Path>) -> Result<P
         PropKind::Mesh => {
             let file = c.file.as_deref().ok_or_else(|| format!("prop '{name}': a mesh needs `file`, an OBJ path"))?;
             let scale = c.scale.unwrap_or(1.0);
-            if !(scale.is_finite() && scale > 0.0) {
-                return Err(format!("prop '{name}': scale must be positive, got {scale}"));
+            if !(scale.is_finite() && scale > 0.0 && scale <= MAX_REACH) {
+                return Err(format!("prop '{name}': scale must be a positive number up to {MAX_REACH}, got {scale:?}"));
             }
-            let (vertices, triangles) = load_obj(file, base_dir).map_err(|e| format!("prop '{name}': {e}"))?;
+            let (vertices, triangles) = load_obj(file, base_dir, scale).map_err(|e| format!("prop '{name}': {e}"))?;
             PropShape::Mesh { vertices: vertices.into_iter().map(|v| v * scale).collect(), triangles }
         }
     };
@@ -46,8 +46,9 @@ fn build_prop(index: usize, c: &PropConfig, base_dir: Option<&Path>) -> Result<P
     Prop::new(&name, shape, DVec3::from_array(c.position), rotation).map_err(|e| e.to_string())
 }
 
-/// Reads an OBJ (all its objects, triangulated) from a bundled asset or a file.
-pub fn load_obj(file: &str, base_dir: Option<&Path>) -> Result<(Vec<DVec3>, Vec<[u32; 3]>), String> {
+/// Reads an OBJ (all its objects, triangulated) from a bundled asset or a file whose
+/// coordinates will be multiplied by `scale`.
+pub fn load_obj(file: &str, base_dir: Option<&Path>, scale: f64) -> Result<(Vec<DVec3>, Vec<[u32; 3]>), String> {
     let text = match ASSETS.iter().find(|a| a.name == file) {
         Some(asset) => asset.text.to_string(),
         None => {
@@ -61,6 +62,7 @@ pub fn load_obj(file: &str, base_dir: Option<&Path>) -> Result<(Vec<DVec3>, Vec<
             })?
         }
     };
+    check_vertices(file, &text, scale)?;
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Ok(Default::default()))
         .map_err(|e| format!("{file} is not a readable OBJ: {e}"))?;
@@ -74,4 +76,26 @@ pub fn load_obj(file: &str, base_dir: Option<&Path>) -> Result<(Vec<DVec3>, Vec<
         return Err(format!("{file} has no faces"));
     }
     Ok((vertices, triangles))
+}
+
+/// Checks every vertex line (`v x y z`) before the OBJ reader sees it, so that a bad
+/// coordinate is named by its line: the reader takes `nan`, `inf` and numbers past f32's
+/// range (1e39) without complaint, and such a prop would silently drop out of contact.
+fn check_vertices(file: &str, text: &str, scale: f64) -> Result<(), String> {
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("v") {
+            continue;
+        }
+        for word in words.take(3) {
+            let value: f64 = word.parse().map_err(|_| format!("{file}:{}: '{word}' is not a number", number + 1))?;
+            if !(value * scale).is_finite() || (value * scale).abs() > MAX_REACH {
+                return Err(format!(
+                    "{file}:{}: coordinate {word} (× scale {scale}) must be finite and within {MAX_REACH} m of the origin; fix the vertex or the prop's scale",
+                    number + 1
+                ));
+            }
+        }
+    }
+    Ok(())
 }

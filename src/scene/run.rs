@@ -22,7 +22,21 @@ pub struct Metrics {
     pub cpu_seconds_per_simulated_second: f64,
     /// CPU seconds per 10 ms simulated, the unit of the paper's Table 1.
     pub cpu_seconds_per_10ms: f64,
+    /// False where a step diverged (`error` says how); the run stopped there.
     pub stable: bool,
+    /// Whether every step's Newton solve converged: its last Newton step was within
+    /// `UNCONVERGED_FACTOR` times `solver.newton.tolerance`. A run that is stable but not
+    /// converged has results that the solver's limits, not the physics, decided.
+    pub converged: bool,
+    /// Steps that stopped at Newton's iteration limit (or left a contact unresolved after
+    /// four solves).
+    pub newton_limit_steps: u64,
+    /// The largest of the steps' last Newton step (largest vertex move) over the mean edge
+    /// length, the measure of `solver.newton.tolerance`; 0 for the explicit integrator.
+    pub worst_residual: f64,
+    /// Why the run stopped before its end at a bound (`--max-steps`, `--max-wall`), if it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped_at_limit: Option<String>,
     /// Whether the run stopped early because the cloth settled (absent when settling is
     /// not watched: `scene.settle_speed` unset).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -91,7 +105,16 @@ pub struct RunOptions<'a> {
     pub progress: Option<&'a mut dyn FnMut(f64)>,
     /// Called after every step that stood, with what it cost.
     pub on_step: Option<&'a mut dyn FnMut(&StepRecord)>,
+    /// Most steps the run may take; the scene's `scene.max_steps` when `None`.
+    pub max_steps: Option<u64>,
+    /// Wall-clock seconds after which the run stops; unbounded when `None`.
+    pub max_wall_seconds: Option<f64>,
 }
+
+/// A step's Newton solve counts as converged when its last step was at most this many
+/// times the tolerance: Newton itself accepts that much when its line search can no longer
+/// lower the energy (round-off), so only a solve cut short by its iteration limit exceeds it.
+pub const UNCONVERGED_FACTOR: f64 = 10.0;
 
 /// One step of a run: what it cost and how fast the cloth moved (`rosette run --step-log`).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -109,6 +132,8 @@ pub struct StepRecord {
     pub shift: f64,
     /// Whether Newton stopped at its iteration limit.
     pub newton_unconverged: bool,
+    /// Newton's last step over the mean edge length (see `Metrics::worst_residual`).
+    pub newton_residual: f64,
     /// Mass-weighted RMS speed of the cloth after the step, m/s.
     pub rms_speed: f64,
     /// Process CPU seconds since the run began.
@@ -120,12 +145,12 @@ pub struct StepRecord {
 impl StepRecord {
     /// The CSV header matching `csv_row`.
     pub const CSV_HEADER: &'static str =
-        "step,time_s,dt_s,newton,cg,factorizations,shift,newton_unconverged,rms_speed_m_s,cpu_s,forces_s,solve_s,contact_s";
+        "step,time_s,dt_s,newton,cg,factorizations,shift,newton_unconverged,rms_speed_m_s,cpu_s,forces_s,solve_s,contact_s,newton_residual";
 
     pub fn csv_row(&self) -> String {
         let t = &self.timings;
         format!(
-            "{},{},{:e},{},{},{},{},{},{:.4e},{:.4},{:.3e},{:.3e},{:.3e}",
+            "{},{},{:e},{},{},{},{},{},{:.4e},{:.4},{:.3e},{:.3e},{:.3e},{:.3e}",
             self.step,
             self.time,
             self.dt,
@@ -138,7 +163,8 @@ impl StepRecord {
             self.cpu_seconds,
             t.forces,
             t.solve,
-            t.contact
+            t.contact,
+            self.newton_residual
         )
     }
 }
@@ -225,9 +251,20 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let mut error = None;
     let mut settle = SettleWatch::new(scene);
     let mut k = 0u64;
+    let (mut limit_steps, mut worst_residual) = (0u64, 0.0f64);
+    let mut stopped_at_limit = None;
+    let max_steps = options.max_steps.unwrap_or(scene.config.scene.max_steps);
     // Steps until the end time is reached (a fixed Δt that does not divide the duration
     // ends past it).
     while scene.state.time < end_time - 1e-6 * scene.integrator.dt {
+        if k >= max_steps {
+            stopped_at_limit = Some(format!("stopped after {k} steps, the bound scene.max_steps (raise it with --max-steps)"));
+            break;
+        }
+        if let Some(limit) = options.max_wall_seconds.filter(|&limit| wall.elapsed().as_secs_f64() > limit) {
+            stopped_at_limit = Some(format!("stopped after {limit} s of wall time, the bound --max-wall (raise it)"));
+            break;
+        }
         k += 1;
         let report = match scene.step() {
             Ok(report) => report,
@@ -241,6 +278,8 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         factorizations += report.factorizations as u64;
         step_time += report.timings;
         rejected += report.rejected as u64;
+        limit_steps += u64::from(report.newton_unconverged);
+        worst_residual = worst_residual.max(report.newton_residual);
         let rms = settle.rms_speed(scene);
         if let Some(f) = on_step.as_deref_mut() {
             f(&StepRecord {
@@ -252,6 +291,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
                 factorizations: report.factorizations,
                 shift: report.shift,
                 newton_unconverged: report.newton_unconverged,
+                newton_residual: report.newton_residual,
                 rms_speed: rms,
                 cpu_seconds: cpu.elapsed().as_secs_f64(),
                 timings: report.timings,
@@ -279,6 +319,10 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         cpu_seconds_per_simulated_second: per_second,
         cpu_seconds_per_10ms: per_second * 0.01,
         stable: error.is_none(),
+        converged: worst_residual <= UNCONVERGED_FACTOR * scene.integrator.newton.tolerance,
+        newton_limit_steps: limit_steps,
+        worst_residual,
+        stopped_at_limit,
         settled: settle.watched().then_some(settle.settled_at.is_some()),
         settle_time: settle.settled_at,
         error: error.as_ref().map(|e| e.to_string()),

@@ -7,19 +7,23 @@
 //! width: stresses and moduli in N/m, bending rigidities in N·m.
 
 use crate::sim::curve::{CurveError, PiecewiseLinear};
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-/// Measured properties of a fabric, in SI units per unit width.
-#[derive(Debug, Clone)]
-pub struct Fabric {
+/// Measured properties of a fabric, in SI units per unit width: the simulator's material,
+/// and (with its curves as lists of points, [`FabricPoints`]) what a fabric file holds. One
+/// definition serves both, so that a property is added in one place.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fabric<Curve = PiecewiseLinear> {
     /// Mass per unit area, kg/m².
     pub areal_density: f64,
     /// Thickness, m (enters eq. 3's twisting term and the contact thickness).
     pub thickness: f64,
     /// Warp tensile curve: stress (N/m) against engineering strain, measured in a uniaxial pull.
-    pub tensile_warp: PiecewiseLinear,
+    pub tensile_warp: Curve,
     /// Weft tensile curve: stress (N/m) against engineering strain.
-    pub tensile_weft: PiecewiseLinear,
+    pub tensile_weft: Curve,
     /// In-plane shear modulus G, N/m (per radian of engineering shear strain).
     pub shear_modulus: f64,
     /// Poisson ratio ν_xy: weft contraction per unit warp strain in a warp pull.
@@ -29,12 +33,45 @@ pub struct Fabric {
     /// Bending rigidity for bending along the weft, N·m.
     pub bending_weft: f64,
     /// Measured rigidity of a strip cut at 45°, N·m; replaces eq. 3's middle term when given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bending_bias: Option<f64>,
     /// Nonlinear bending: a warp moment–curvature curve, moment per unit width (N·m/m)
     /// against curvature (1/m). Its shape (moments over its initial slope) scales the
     /// rigidities with curvature in every direction; `bending_warp` keeps setting the
     /// small-curvature rigidity. `None` is linear bending.
-    pub bending_curve: Option<PiecewiseLinear>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_curve: Option<Curve>,
+}
+
+/// A fabric as a file gives it: every curve a list of `[x, y]` points, not yet checked.
+pub type FabricPoints = Fabric<Vec<[f64; 2]>>;
+
+impl<C> Fabric<C> {
+    /// The same fabric with every curve mapped by `f` (given the curve's key): the one place
+    /// that lists the curves.
+    pub fn try_map_curves<D, E>(&self, f: impl Fn(&'static str, &C) -> Result<D, E>) -> Result<Fabric<D>, E> {
+        Ok(Fabric {
+            areal_density: self.areal_density,
+            thickness: self.thickness,
+            tensile_warp: f("tensile_warp", &self.tensile_warp)?,
+            tensile_weft: f("tensile_weft", &self.tensile_weft)?,
+            shear_modulus: self.shear_modulus,
+            poisson_warp: self.poisson_warp,
+            bending_warp: self.bending_warp,
+            bending_weft: self.bending_weft,
+            bending_bias: self.bending_bias,
+            bending_curve: self.bending_curve.as_ref().map(|c| f("bending_curve", c)).transpose()?,
+        })
+    }
+}
+
+impl FabricPoints {
+    /// The material: every curve built and every property checked.
+    pub fn to_fabric(&self) -> Result<Fabric, FabricError> {
+        let fabric = self.try_map_curves(|key, points| PiecewiseLinear::new_material(points).map_err(|source| FabricError::Curve { key, source }))?;
+        fabric.validate()?;
+        Ok(fabric)
+    }
 }
 
 /// A fabric property that is out of range, named by its preset key.
@@ -50,6 +87,13 @@ pub enum FabricError {
          segments of the curves"
     )]
     PoissonTooLarge { nu: f64, limit: f64 },
+    #[error("fabric.{key} = {value:e} is beyond any fabric (at most {max:e} in SI units; a 1 cm steel plate stays below it): check the units")]
+    TooLarge { key: &'static str, value: f64, max: f64 },
+    #[error(
+        "fabric.{key} has a segment of slope {slope:e}, beyond any fabric (at most {max:e} in SI units; a 1 cm steel plate \
+         stays below it): check the units of its points"
+    )]
+    SteepCurve { key: &'static str, slope: f64, max: f64 },
     #[error(
         "fabric.bending_bias = {bias} N·m is too small for bending_warp = {warp} and bending_weft = {weft}: \
          eq. 3 would need a negative twisting rigidity; use at least {min:.3e} N·m"
@@ -57,22 +101,61 @@ pub enum FabricError {
     BiasTooSmall { bias: f64, warp: f64, weft: f64, min: f64 },
 }
 
-fn positive(key: &'static str, value: f64) -> Result<(), FabricError> {
-    if value.is_finite() && value > 0.0 {
+impl FabricError {
+    /// The fabric key the error is about (the key under `fabric.`).
+    pub fn key(&self) -> &'static str {
+        match self {
+            Self::OutOfRange { key, .. } | Self::Curve { key, .. } | Self::TooLarge { key, .. } | Self::SteepCurve { key, .. } => key,
+            Self::PoissonTooLarge { .. } => "poisson_warp",
+            Self::BiasTooSmall { .. } => "bending_bias",
+        }
+    }
+}
+
+/// Ceilings far beyond any fabric, which put a typo's 1e300 in front of the user instead of
+/// letting it overflow the solver's arithmetic into a NaN: a 1 cm steel plate, stiffer than
+/// any cloth, has E·h ≈ 2e9 N/m, a bending rigidity E·h³/12 ≈ 2e4 N·m and 79 kg/m².
+const MAX_AREAL_DENSITY: f64 = 1e3;
+/// A floor for the mass: 1 g/m², a tenth of the lightest nonwovens. Lighter, the cloth has
+/// no inertia to speak of and contact's penalty (scaled by the mass) no force: the Newton
+/// solves then run to their limits on every step.
+const MIN_AREAL_DENSITY: f64 = 1e-3;
+const MAX_THICKNESS: f64 = 0.1;
+const MAX_MODULUS: f64 = 1e11;
+const MAX_RIGIDITY: f64 = 1e6;
+
+fn in_range(key: &'static str, value: f64, max: f64) -> Result<(), FabricError> {
+    if !(value.is_finite() && value > 0.0) {
+        Err(FabricError::OutOfRange { key, expected: "a positive finite number", value })
+    } else if value > max {
+        Err(FabricError::TooLarge { key, value, max })
+    } else {
+        Ok(())
+    }
+}
+
+/// A curve's steepest segment, checked against `max` (N/m for tensile curves, N·m for the
+/// bending curve).
+fn curve_in_range(key: &'static str, curve: &PiecewiseLinear, max: f64) -> Result<(), FabricError> {
+    let slope = curve.max_slope();
+    if slope <= max {
         Ok(())
     } else {
-        Err(FabricError::OutOfRange { key, expected: "a positive finite number", value })
+        Err(FabricError::SteepCurve { key, slope, max })
     }
 }
 
 impl Fabric {
     /// Checks every property and that the laws built from them are stable.
     pub fn validate(&self) -> Result<(), FabricError> {
-        positive("areal_density", self.areal_density)?;
-        positive("thickness", self.thickness)?;
-        positive("shear_modulus", self.shear_modulus)?;
-        positive("bending_warp", self.bending_warp)?;
-        positive("bending_weft", self.bending_weft)?;
+        in_range("areal_density", self.areal_density, MAX_AREAL_DENSITY)?;
+        if self.areal_density < MIN_AREAL_DENSITY {
+            return Err(FabricError::OutOfRange { key: "areal_density", expected: "at least 1e-3 kg/m² (1 g/m²; the lightest fabrics weigh about 10)", value: self.areal_density });
+        }
+        in_range("thickness", self.thickness, MAX_THICKNESS)?;
+        in_range("shear_modulus", self.shear_modulus, MAX_MODULUS)?;
+        in_range("bending_warp", self.bending_warp, MAX_RIGIDITY)?;
+        in_range("bending_weft", self.bending_weft, MAX_RIGIDITY)?;
         if !(0.0..0.5).contains(&self.poisson_warp) {
             return Err(FabricError::OutOfRange {
                 key: "poisson_warp",
@@ -81,11 +164,47 @@ impl Fabric {
             });
         }
         if let Some(bias) = self.bending_bias {
-            positive("bending_bias", bias)?;
+            in_range("bending_bias", bias, MAX_RIGIDITY)?;
+        }
+        curve_in_range("tensile_warp", &self.tensile_warp, MAX_MODULUS)?;
+        curve_in_range("tensile_weft", &self.tensile_weft, MAX_MODULUS)?;
+        if let Some(curve) = &self.bending_curve {
+            curve_in_range("bending_curve", curve, MAX_RIGIDITY)?;
         }
         MembraneLaw::new(self)?;
         BendingStiffness::new(self)?;
         Ok(())
+    }
+
+    /// Sub-element buckling for elements of edge length `edge`, m: compressive stress along
+    /// the warp and the weft is capped at the Euler load of one element, π²B/ℓ², beyond which
+    /// it grows at 1 % of the initial tensile slope. A triangle stands for cloth that would
+    /// have buckled within it; without the cap coarse meshes lock in folds. A curve with
+    /// compression points of its own is kept as it is.
+    pub fn with_compression_buckling(&self, edge: f64) -> Result<Fabric, FabricError> {
+        let branch = |key: &'static str, curve: &PiecewiseLinear, rigidity: f64| {
+            let mut points: Vec<[f64; 2]> = curve.points().collect();
+            // A material curve passes through the origin: its first point is the origin
+            // unless it has points in compression.
+            if points[0][0] < 0.0 {
+                return Ok(curve.clone());
+            }
+            let slope = points[1][1] / points[1][0];
+            let critical = std::f64::consts::PI.powi(2) * rigidity / (edge * edge);
+            let knee = critical / slope;
+            // Far enough that no cloth gets there: half its length.
+            let far = 0.5f64.max(2.0 * knee);
+            points.insert(0, [-knee, -critical]);
+            points.insert(0, [-far, -critical - 0.01 * slope * (far - knee)]);
+            PiecewiseLinear::new_material(&points).map_err(|source| FabricError::Curve { key, source })
+        };
+        let fabric = Fabric {
+            tensile_warp: branch("tensile_warp", &self.tensile_warp, self.bending_warp)?,
+            tensile_weft: branch("tensile_weft", &self.tensile_weft, self.bending_weft)?,
+            ..self.clone()
+        };
+        fabric.validate()?;
+        Ok(fabric)
     }
 
     /// Weight per unit area, N/m², under gravity `g` (m/s²).

@@ -73,6 +73,24 @@ fn check_count(edge_length: f64, count: usize) -> Result<(), MeshError> {
     Ok(())
 }
 
+/// The vertex count each generator checks against [`MAX_VERTICES`] before it builds: a
+/// `length × width` rectangle with `pattern`, or (`width` = None) a disc of diameter
+/// `length`. Lets a scene be checked before its fabric, whose buckling branch divides by
+/// the edge length squared.
+pub fn planned_vertices(length: f64, width: Option<f64>, edge_length: f64, pattern: Pattern) -> usize {
+    let cells = |extent: f64, spacing: f64| ((extent / spacing).round() as usize).max(1);
+    match width {
+        None => {
+            let ring_count = cells(length / 2.0, edge_length);
+            (std::f64::consts::PI * (ring_count as f64 + 1.0).powi(2) * 1.2) as usize
+        }
+        Some(width) if pattern == Pattern::Equilateral => {
+            cells(length, edge_length).saturating_add(2).saturating_mul(cells(width, edge_length * 3f64.sqrt() / 2.0).saturating_add(1))
+        }
+        Some(width) => cells(length, edge_length).saturating_add(1).saturating_mul(cells(width, edge_length).saturating_add(1)),
+    }
+}
+
 impl Mesh {
     /// A `length × width` rectangle with edges of about `edge_length`.
     pub fn rectangle(length: f64, width: f64, edge_length: f64, pattern: Pattern, seed: u64) -> Result<Self, MeshError> {

@@ -91,7 +91,7 @@ impl ContactModel {
     pub(super) fn self_pairs(&self, cloth: Cloth, near: &mut NearPairs, start: &[DVec3], predicted: &[DVec3], h: f64) -> Vec<SelfPair> {
         let (fixed, mass, triangles, edges) = (cloth.fixed, cloth.mass, cloth.triangles, cloth.edges);
         let parallel = triangles.len() >= PARALLEL_TRIANGLES;
-        let delta = self.settings.self_thickness;
+        let delta = self.settings.self_thickness_for(cloth.mean_edge_length);
         let motion: Vec<f64> = start.iter().zip(predicted).map(|(a, b)| a.distance(*b)).collect();
         let near = Self::near_pairs(cloth, near, start, motion.iter().copied().fold(0.0, f64::max), delta);
         let stiffness = |m: f64| self.settings.stiffness * m / (h * h);
@@ -143,7 +143,7 @@ impl ContactModel {
     pub fn stop_self_crossings(&self, cloth: Cloth, near: &mut NearPairs, start: &[DVec3], end: &mut [DVec3], v: &mut [DVec3]) -> u64 {
         let (mass, triangles, edges) = (cloth.mass, cloth.triangles, cloth.edges);
         let n = start.len();
-        let eps = 1e-3 * self.settings.self_thickness;
+        let eps = 1e-3 * self.settings.self_thickness_for(cloth.mean_edge_length);
         let mut zone: Vec<u32> = (0..n as u32).collect();
         fn root(zone: &mut [u32], mut i: u32) -> u32 {
             while zone[i as usize] != i {
@@ -369,7 +369,7 @@ mod tests {
         let mesh = Mesh::rectangle(0.04, 0.02, edge, Pattern::Regular, 0).unwrap();
         let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
         assert_eq!(model.triangles.len() >= PARALLEL_TRIANGLES, edge < 0.001, "{} triangles", model.triangles.len());
-        let settings = ContactSettings { self_collision: true, self_thickness: 0.002, ..Default::default() };
+        let settings = ContactSettings { self_collision: true, self_thickness: Some(0.002), ..Default::default() };
         let contact = ContactModel::new(Vec::new(), settings).unwrap();
         let folded = |p: DVec2, drift: DVec3| {
             // The layers drift apart in opposite directions, as closing pairs would.
@@ -385,7 +385,7 @@ mod tests {
             let contacts = contact.begin_step(model.cloth(), &mut near, &start, &predicted, 0.004);
             let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
             assert_eq!(listed.len(), contacts.pairs.len(), "step {step}: a pair listed twice");
-            assert_eq!(listed, all_pairs(&model, &start, &predicted, settings.self_thickness), "step {step}");
+            assert_eq!(listed, all_pairs(&model, &start, &predicted, 0.002), "step {step}");
             total += listed.len();
         }
         total

@@ -242,6 +242,14 @@ impl SpatialHash {
     fn for_buckets(&self, lo: DVec3, hi: DVec3, mut f: impl FnMut(usize)) {
         let key = |p: DVec3| (p / self.cell).floor().as_ivec3();
         let (a, b) = (key(lo), key(hi));
+        // A box over more cells than the table has buckets (a cloth blown far apart, or a
+        // coordinate that is not finite and saturates the cell index) touches every bucket
+        // at most once: a bounded loop instead of one over up to 2⁹⁶ cells.
+        let cells = |lo: i32, hi: i32| (i64::from(hi) - i64::from(lo) + 1).max(0) as u128;
+        if cells(a.x, b.x) * cells(a.y, b.y) * cells(a.z, b.z) > u128::from(self.mask) + 1 {
+            (0..=self.mask as usize).for_each(f);
+            return;
+        }
         for x in a.x..=b.x {
             for y in a.y..=b.y {
                 for z in a.z..=b.z {

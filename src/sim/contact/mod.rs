@@ -44,9 +44,10 @@ pub mod props;
 mod step;
 
 pub use cloth::{NearPairs, count_self_intersections};
-pub use props::{Prop, PropError, PropShape, SurfacePoint};
+pub use props::{MAX_REACH, Prop, PropError, PropShape, SurfacePoint};
 
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 
 /// What contact reads of the cloth: its topology and masses.
 #[derive(Debug, Clone, Copy)]
@@ -62,22 +63,27 @@ pub struct Cloth<'a> {
     pub mean_edge_length: f64,
 }
 
-/// Contact parameters, SI units.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Contact parameters, SI units: the `[contact]` section of a scene file.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct ContactSettings {
-    /// Distance the cloth keeps from props, m.
+    /// Distance the cloth keeps from a prop's surface, m.
     pub thickness: f64,
-    /// Coulomb coefficient while sticking.
+    /// Coulomb friction coefficient while sticking.
     pub friction_static: f64,
-    /// Coulomb coefficient while sliding.
+    /// Coulomb friction coefficient while sliding (at most the static one).
     pub friction_kinetic: f64,
-    /// Cloth–cloth contact on or off.
+    /// Cloth–cloth contact in folds. Off where the cloth cannot touch itself.
     pub self_collision: bool,
-    /// Distance kept between cloth layers, m.
-    pub self_thickness: f64,
-    /// Penalty stiffness as a multiple of m/h² (implicit integrators).
+    /// Distance kept between cloth layers, m; absent: the smaller of the prop thickness
+    /// and a fifth of the mean edge length (`self_thickness_for`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub self_thickness: Option<f64>,
+    /// Contact penalty stiffness as a multiple of m/Δt² per vertex (implicit solvers).
     pub stiffness: f64,
-    /// Tangential speed below which friction sticks, m/s.
+    /// Tangential speed below which friction sticks, m/s. Smoothed (IPC) friction lets a
+    /// sticking cloth under a sideways pull F creep at slip_speed·F/(μN): keep it well
+    /// below the speeds a scene should resolve, and below its settle speed.
     pub slip_speed: f64,
 }
 
@@ -88,7 +94,7 @@ impl Default for ContactSettings {
             friction_static: 0.5,
             friction_kinetic: 0.4,
             self_collision: false,
-            self_thickness: 0.001,
+            self_thickness: None,
             stiffness: 100.0,
             slip_speed: 1e-3,
         }
@@ -96,14 +102,23 @@ impl Default for ContactSettings {
 }
 
 impl ContactSettings {
+    /// The distance kept between cloth layers on a mesh of this mean edge length, m.
+    pub fn self_thickness_for(&self, mean_edge_length: f64) -> f64 {
+        self.self_thickness.unwrap_or(self.thickness.min(0.2 * mean_edge_length))
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         let positive = |key: &str, v: f64| if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("contact.{key} must be positive, got {v}")) };
         positive("thickness", self.thickness)?;
-        positive("self_thickness", self.self_thickness)?;
+        if let Some(v) = self.self_thickness {
+            positive("self_thickness", v)?;
+        }
         positive("stiffness", self.stiffness)?;
         positive("slip_speed", self.slip_speed)?;
-        if !(self.friction_static >= 0.0 && self.friction_kinetic >= 0.0 && self.friction_static.is_finite()) {
-            return Err("contact.friction_static and contact.friction_kinetic must be zero or positive".into());
+        for (key, v) in [("friction_static", self.friction_static), ("friction_kinetic", self.friction_kinetic)] {
+            if !(v >= 0.0 && v.is_finite()) {
+                return Err(format!("contact.{key} must be zero or positive, got {v}"));
+            }
         }
         if self.friction_kinetic > self.friction_static {
             return Err(format!(
@@ -212,7 +227,7 @@ impl ContactModel {
             mu_static: s.friction_static,
             mu_kinetic: s.friction_kinetic,
             thickness: s.thickness,
-            self_thickness: s.self_thickness,
+            self_thickness: s.self_thickness_for(cloth.mean_edge_length),
             slip: s.slip_speed * h,
         };
         let per_vertex = filter_in_order(start, parallel, |v, _| {

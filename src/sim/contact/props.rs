@@ -18,6 +18,15 @@ fn to_f64(v: Vec3) -> DVec3 {
     v.as_dvec3()
 }
 
+/// Farthest a prop or the cloth may lie from the origin, and the largest prop, m. The props'
+/// f32 geometry resolves 6e-5 m there, a thirtieth of the default 2 mm contact layer;
+/// farther out, contact would be decided by rounding.
+pub const MAX_REACH: f64 = 1e3;
+
+/// Smallest prop size, m: below a tenth of a millimetre the f32 geometry a metre from the
+/// origin (6e-8 m) keeps too few digits of the shape.
+pub const MIN_SIZE: f64 = 1e-4;
+
 /// The geometric kinds of prop, in the simulator's z-up world.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PropShape {
@@ -72,10 +81,19 @@ impl Prop {
     pub fn new(name: &str, shape: PropShape, position: DVec3, rotation: DQuat) -> Result<Self, PropError> {
         let invalid = |message: String| PropError::Invalid { name: name.to_string(), message };
         let positive = |what: &str, value: f64| {
-            if value.is_finite() && value > 0.0 { Ok(()) } else { Err(invalid(format!("{what} must be positive, got {value}"))) }
+            if !(value.is_finite() && value > 0.0) {
+                Err(invalid(format!("{what} must be positive, got {value}")))
+            } else if !(MIN_SIZE..=MAX_REACH).contains(&value) {
+                Err(invalid(format!("{what} = {value:?} m is outside what contact resolves, {MIN_SIZE} to {MAX_REACH} m")))
+            } else {
+                Ok(())
+            }
         };
-        if !position.is_finite() {
-            return Err(invalid(format!("position {position} is not finite")));
+        if !position.is_finite() || position.abs().max_element() > MAX_REACH {
+            return Err(invalid(format!("position {position} must be finite and within {MAX_REACH} m of the origin")));
+        }
+        if !rotation.is_finite() || !rotation.is_normalized() {
+            return Err(invalid(format!("rotation {rotation} is not a finite rotation; give finite angles")));
         }
         // parry3d's cylinder runs along its local y axis; ours along z.
         let mut local_frame = Quat::IDENTITY;
@@ -100,6 +118,9 @@ impl Prop {
             PropShape::Mesh { vertices, triangles } => {
                 if triangles.is_empty() {
                     return Err(invalid("the mesh has no triangles".into()));
+                }
+                if let Some((i, v)) = vertices.iter().enumerate().find(|(_, v)| !v.is_finite() || v.abs().max_element() > MAX_REACH) {
+                    return Err(invalid(format!("vertex {} at {v} must be finite and within {MAX_REACH} m of the origin", i + 1)));
                 }
                 if let Some(t) = triangles.iter().find(|t| t.iter().any(|&i| i as usize >= vertices.len())) {
                     return Err(invalid(format!("triangle {t:?} refers to a vertex past the {} given", vertices.len())));

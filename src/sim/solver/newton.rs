@@ -124,7 +124,8 @@ impl Integrator {
         for _ in 0..self.newton.max_iterations {
             let norm = self.gradient(&problem, y, &mut work.gradient, &mut watch);
             work.rhs = work.gradient.iter().map(|g| -*g).collect();
-            if self.last_step_from_preconditioner(&problem, &history, norm, &mut work, y, &mut watch) {
+            if let Some(length) = self.last_step_from_preconditioner(&problem, &history, norm, &mut work, y, &mut watch) {
+                history.previous_step = Some(length);
                 report.newton_unconverged = false;
                 break;
             }
@@ -142,6 +143,7 @@ impl Integrator {
             }
         }
         report.timings += watch.timings;
+        report.newton_residual = history.previous_step.map_or(f64::INFINITY, |step| step / model.mean_edge_length);
     }
 
     /// ∇Φ at `y` into `gradient` (zero on fixed vertices), and its norm.
@@ -176,16 +178,16 @@ impl Integrator {
     /// it is taken with the last preconditioner instead of being assembled and solved for:
     /// while Newton converges the step shrinks as the gradient does, so the last full step
     /// scaled by the gradient's decrease predicts it, and the preconditioner (a factor of a
-    /// recent Newton matrix) gives it to within that factor's error. True if it was taken
-    /// (Newton has converged); otherwise the iteration goes on as usual. A converging
+    /// recent Newton matrix) gives it to within that factor's error. The step's length if it
+    /// was taken (Newton has converged); otherwise the iteration goes on as usual. A converging
     /// Newton solve's last iteration would otherwise be a whole assembly and solve for a
     /// step under the tolerance.
-    fn last_step_from_preconditioner(&self, problem: &NewtonProblem, history: &NewtonHistory, norm: f64, work: &mut NewtonWork, y: &mut [DVec3], watch: &mut Stopwatch) -> bool {
+    fn last_step_from_preconditioner(&self, problem: &NewtonProblem, history: &NewtonHistory, norm: f64, work: &mut NewtonWork, y: &mut [DVec3], watch: &mut Stopwatch) -> Option<f64> {
         let (Some(before), Some(full), Some(cached)) = (history.previous_norm, history.previous_full_step, self.preconditioner.as_ref()) else {
-            return false;
+            return None;
         };
         if !(cached.size == y.len() && norm < 0.5 * before && full * norm / before < problem.tolerance) {
-            return false;
+            return None;
         }
         cached.preconditioner.apply(&work.rhs, &mut work.direction);
         if problem.all_free {
@@ -200,9 +202,9 @@ impl Integrator {
                     y[i] += *d;
                 }
             }
-            return true;
+            return Some(length);
         }
-        false
+        None
     }
 
     /// The relative residual to solve this iteration's linear system to.

@@ -25,6 +25,9 @@ pub struct StepReport {
     pub factorizations: usize,
     /// True when Newton stopped at its iteration limit before reaching its tolerance.
     pub newton_unconverged: bool,
+    /// Newton's last step (the largest vertex move) over the mean edge length: below
+    /// `NewtonSettings::tolerance` where Newton converged, 0 for the explicit integrator.
+    pub newton_residual: f64,
     /// Where the step's time went.
     pub timings: StepTimings,
     /// The time step taken, s.

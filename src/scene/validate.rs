@@ -1,0 +1,369 @@
+//! The checks a scene passes before anything is built: every number finite and in range,
+//! the values consistent with each other and with the scene's kind, and the run short
+//! enough for its step bound. Each refusal names the key and says how to fix it.
+//!
+//! Ranges are what the simulator can honour, not what is typical: a value is refused where
+//! it would overflow the arithmetic, break the mesh or make a measure meaningless (a
+//! support larger than the specimen), never merely because it is unusual.
+
+use super::preset::{SceneConfig, SceneKind};
+use crate::sim::contact::MAX_REACH;
+use crate::sim::mesh::{MAX_VERTICES, planned_vertices};
+
+/// A refused value: its dotted key and why, with the fix.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Invalid {
+    pub key: String,
+    pub message: String,
+}
+
+fn invalid(key: &str, message: String) -> Invalid {
+    Invalid { key: key.to_string(), message }
+}
+
+fn positive(key: &str, v: f64) -> Result<f64, Invalid> {
+    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be a positive number, got {v:?}"))) }
+}
+
+fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
+    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be zero or a positive number, got {v:?}"))) }
+}
+
+/// Positive and at most `max` (`why` says what the bound is).
+fn positive_at_most(key: &str, v: f64, max: f64, why: &str) -> Result<f64, Invalid> {
+    positive(key, v)?;
+    if v > max {
+        return Err(invalid(key, format!("{key} = {v:?} is more than {max:?} ({why})")));
+    }
+    Ok(v)
+}
+
+/// A point within the reach of the props' single-precision geometry.
+fn point(key: &str, p: [f64; 3]) -> Result<(), Invalid> {
+    if p.iter().any(|c| !c.is_finite()) {
+        return Err(invalid(key, format!("{key} must be three finite coordinates in metres, got {p:?}")));
+    }
+    if p.iter().any(|c| c.abs() > MAX_REACH) {
+        return Err(invalid(key, format!("{key} = {p:?} lies more than {MAX_REACH} m from the origin, beyond what contact resolves; move the scene nearer")));
+    }
+    Ok(())
+}
+
+/// Refuses a run of `duration` seconds (given by `key`) at steps of `dt` that needs more
+/// than `max_steps` steps, with the bound to raise or the values to change.
+pub fn check_step_count(key: &str, duration: f64, dt: f64, max_steps: u64) -> Result<(), Invalid> {
+    let needed = (duration / dt).ceil();
+    if needed > max_steps as f64 {
+        return Err(invalid(
+            key,
+            format!(
+                "{key} = {duration:?} s at solver.dt = {dt:?} s needs {needed:.3e} steps, more than scene.max_steps = {max_steps}: \
+                 use a larger solver.dt or a shorter duration, or raise the bound (--max-steps {needed:.0})"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Which scene kinds read each test key: a key another kind would silently ignore is refused.
+const TEST_KEYS: &[(&str, &[SceneKind])] = {
+    use SceneKind::*;
+    &[
+        ("max_strain", &[Tensile]),
+        ("end_shortening", &[EulerBuckling]),
+        ("shear_angle_deg", &[ShearBuckling]),
+        ("speed", &[Tensile, EulerBuckling, ShearBuckling]),
+        ("curvature", &[Arc]),
+        ("clamp_length", &[Cantilever, Arc]),
+        ("shear_kinematics", &[ShearBuckling]),
+        ("clamp_radius", &[Drape]),
+        ("support_diameter", &[Drape]),
+        ("support_size", &[Drape]),
+    ]
+};
+
+/// Checks a whole scene (see the module's doc).
+pub fn check_scene(c: &SceneConfig) -> Result<(), Invalid> {
+    let s = &c.scene;
+    positive("scene.duration", s.duration)?;
+    positive("scene.settle_window", s.settle_window)?;
+    if let Some(v) = s.settle_speed {
+        positive("scene.settle_speed", v)?;
+    }
+    if let Some(v) = s.gravity_ramp {
+        positive("scene.gravity_ramp", v)?;
+    }
+    if s.max_steps == 0 {
+        return Err(invalid("scene.max_steps", "scene.max_steps must be at least 1".into()));
+    }
+    check_solver(c)?;
+    check_step_count("scene.duration", s.duration, c.solver.dt, s.max_steps)?;
+    let extent = check_cloth(c)?;
+    check_mesh(c, &extent)?;
+    let extent = extent.size;
+    c.material().map_err(|e| invalid(&format!("fabric.{}", e.key()), e.to_string()))?;
+    check_test(c, extent)?;
+    check_contact(c, extent)?;
+    for (i, p) in c.props.iter().enumerate() {
+        point(&format!("props[{i}].position"), p.position)?;
+        if p.rotation_deg.iter().any(|a| !(a.is_finite() && a.abs() <= 360.0)) {
+            return Err(invalid(&format!("props[{i}].rotation_deg"), format!("props[{i}].rotation_deg must be three angles between -360 and 360 degrees, got {:?}", p.rotation_deg)));
+        }
+    }
+    Ok(())
+}
+
+fn check_solver(c: &SceneConfig) -> Result<(), Invalid> {
+    let (solver, duration) = (&c.solver, c.scene.duration);
+    positive("solver.dt", solver.dt)?;
+    if solver.dt > duration {
+        return Err(invalid("solver.dt", format!("solver.dt = {} s is longer than scene.duration = {duration} s; use a shorter step", solver.dt)));
+    }
+    non_negative("solver.damping", solver.damping)?;
+    // Drag stronger than a step's inertia a billion times over leaves nothing to simulate
+    // and loses the Newton system's digits.
+    let most = 1e9 / solver.dt;
+    if solver.damping > most {
+        return Err(invalid("solver.damping", format!("solver.damping = {} 1/s stops any motion within a billionth of a step; use at most {most:?}", solver.damping)));
+    }
+    let n = &solver.newton;
+    if n.max_iterations == 0 {
+        return Err(invalid("solver.newton.max_iterations", "solver.newton.max_iterations must be at least 1 (default 30): with none, no step is solved".into()));
+    }
+    if n.cg_max_iterations == 0 {
+        return Err(invalid("solver.newton.cg_max_iterations", "solver.newton.cg_max_iterations must be at least 1 (default 3000): with none, Newton has no direction".into()));
+    }
+    positive_at_most("solver.newton.tolerance", n.tolerance, 0.1, "a tenth of an edge: Newton would stop before it starts; the default is 1e-5")?;
+    positive("solver.newton.cg_tolerance", n.cg_tolerance)?;
+    if n.cg_tolerance >= 1.0 {
+        return Err(invalid("solver.newton.cg_tolerance", format!("solver.newton.cg_tolerance = {} must be below 1 (a relative residual; the default is 1e-3)", n.cg_tolerance)));
+    }
+    if let Some(a) = solver.adaptive.filter(|a| a.enabled) {
+        positive("solver.adaptive.tolerance", a.tolerance)?;
+        positive("solver.adaptive.dt_min", a.dt_min)?;
+        positive("solver.adaptive.dt_max", a.dt_max)?;
+        if !(a.dt_min <= solver.dt && solver.dt <= a.dt_max) {
+            return Err(invalid(
+                "solver.dt",
+                format!("solver.dt = {} s must lie between solver.adaptive.dt_min = {} s and dt_max = {} s", solver.dt, a.dt_min, a.dt_max),
+            ));
+        }
+        if solver.integrator.is_explicit() {
+            return Err(invalid(
+                "solver.adaptive",
+                format!(
+                    "solver.adaptive works with the implicit integrators; {} is stable only below a fixed \
+                     limit: set solver.adaptive.enabled = false or solver.integrator = \"implicit-euler\"",
+                    solver.integrator
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The cloth's smallest extent, m (the disc's diameter or the rectangle's shorter side),
+/// and the key that gives it.
+struct Extent {
+    size: f64,
+    key: &'static str,
+}
+
+/// The cloth's size and place.
+fn check_cloth(c: &SceneConfig) -> Result<Extent, Invalid> {
+    let cloth = &c.cloth;
+    if !(cloth.warp_angle_deg.is_finite() && cloth.warp_angle_deg.abs() <= 360.0) {
+        return Err(invalid("cloth.warp_angle_deg", format!("cloth.warp_angle_deg must be an angle between -360 and 360 degrees, got {}", cloth.warp_angle_deg)));
+    }
+    point("cloth.position", cloth.position)?;
+    let size = |key: &str, v: f64| positive_at_most(key, v, MAX_REACH, "larger than the room contact resolves");
+    let disc = c.scene.kind == SceneKind::Drape && cloth.diameter != 0.0;
+    if disc {
+        let d = size("cloth.diameter", cloth.diameter)?;
+        for (key, v) in [("cloth.length", cloth.length), ("cloth.width", cloth.width)] {
+            if v != 0.0 {
+                return Err(invalid(key, format!("{key} has no meaning for a disc (cloth.diameter = {d} m); remove it, or set cloth.diameter = 0 for a rectangle")));
+            }
+        }
+        return Ok(Extent { size: d, key: "cloth.diameter" });
+    }
+    if cloth.diameter != 0.0 {
+        return Err(invalid("cloth.diameter", "cloth.diameter is read by drape scenes only; this scene's cloth is the rectangle cloth.length × cloth.width".into()));
+    }
+    if c.scene.kind == SceneKind::Drape && (cloth.length == 0.0 || cloth.width == 0.0) {
+        return Err(invalid(
+            "cloth.diameter",
+            "a drape cloth needs cloth.diameter (a disc) or cloth.length and cloth.width (a rectangle), in metres".into(),
+        ));
+    }
+    let length = size("cloth.length", cloth.length)?;
+    let width = size("cloth.width", cloth.width)?;
+    Ok(if length <= width { Extent { size: length, key: "cloth.length" } } else { Extent { size: width, key: "cloth.width" } })
+}
+
+fn check_mesh(c: &SceneConfig, extent: &Extent) -> Result<(), Invalid> {
+    let h = positive("mesh.edge_length", c.mesh.edge_length)?;
+    // Each triangle's bending stencil needs neighbours that are not collinear with it: one
+    // element across leaves them in a row (singular), two is the fewest that every pattern
+    // and bundled scene builds with.
+    let most = extent.size / 2.0;
+    if h > most {
+        return Err(invalid(
+            "mesh.edge_length",
+            format!(
+                "mesh.edge_length = {h:?} m leaves fewer than 2 elements across the cloth's {:?} m ({}); use at most {most:?} m, or a larger cloth",
+                extent.size, extent.key
+            ),
+        ));
+    }
+    // The mesh generators refuse past their vertex cap too, but only after the fabric (whose
+    // buckling branch divides by the edge length squared) has been checked.
+    let cloth = &c.cloth;
+    let disc = c.scene.kind == SceneKind::Drape && cloth.diameter != 0.0;
+    let planned = |h: f64| {
+        if disc { planned_vertices(cloth.diameter, None, h, c.mesh.pattern) } else { planned_vertices(cloth.length, Some(cloth.width), h, c.mesh.pattern) }
+    };
+    let vertices = planned(h);
+    if vertices > MAX_VERTICES {
+        // The finest edge under the cap, by bisection on its logarithm (the count falls as
+        // the edge grows, and two elements across is far under the cap).
+        let (mut fails, mut passes) = (h, most);
+        for _ in 0..100 {
+            let mid = (fails * passes).sqrt();
+            if planned(mid) > MAX_VERTICES { fails = mid } else { passes = mid }
+        }
+        let least = 1.001 * passes;
+        return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {h:?} m gives about {vertices} vertices, more than the limit of {MAX_VERTICES}; use at least {least:.3e} m")));
+    }
+    Ok(())
+}
+
+fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
+    let (t, kind) = (&c.test, c.scene.kind);
+    let given = [
+        ("max_strain", t.max_strain.is_some()),
+        ("end_shortening", t.end_shortening.is_some()),
+        ("shear_angle_deg", t.shear_angle_deg.is_some()),
+        ("speed", t.speed.is_some()),
+        ("curvature", t.curvature.is_some()),
+        ("clamp_length", t.clamp_length.is_some()),
+        ("shear_kinematics", t.shear_kinematics.is_some()),
+        ("clamp_radius", t.clamp_radius.is_some()),
+        ("support_diameter", t.support_diameter.is_some()),
+        ("support_size", t.support_size.is_some()),
+    ];
+    for (key, kinds) in TEST_KEYS {
+        if given.iter().any(|(k, set)| k == key && *set) && !kinds.contains(&kind) {
+            let key = format!("test.{key}");
+            return Err(invalid(&key, format!("{key} has no effect on a {kind:?} scene (it is read by {kinds:?} scenes); remove it")));
+        }
+    }
+    let need = |key: &str, v: Option<f64>| -> Result<f64, Invalid> {
+        let v = v.ok_or_else(|| invalid(key, format!("{key} is required for a {kind:?} scene")))?;
+        positive(key, v)
+    };
+    let length = c.cloth.length;
+    if let Some(a) = t.perturbation {
+        non_negative("test.perturbation", a)?;
+        // A perturbation breaks the symmetry; one larger than an element stretches the
+        // mesh's edges past √2 before the run starts.
+        let h = c.mesh.edge_length;
+        if a > h {
+            return Err(invalid("test.perturbation", format!("test.perturbation = {a} m is larger than an element (mesh.edge_length = {h} m); use at most {h}")));
+        }
+    }
+    match kind {
+        SceneKind::Tensile => {
+            let strain = need("test.max_strain", t.max_strain)?;
+            if strain > 1.0 {
+                return Err(invalid("test.max_strain", format!("test.max_strain = {strain} pulls past 100 % strain, where fabrics have long broken; use at most 1")));
+            }
+            need("test.speed", t.speed)?;
+        }
+        SceneKind::EulerBuckling => {
+            let s = need("test.end_shortening", t.end_shortening)?;
+            if s >= 0.9 {
+                return Err(invalid("test.end_shortening", format!("test.end_shortening = {s} leaves almost no strip; use a fraction below 0.9")));
+            }
+            need("test.speed", t.speed)?;
+        }
+        SceneKind::ShearBuckling => {
+            let a = need("test.shear_angle_deg", t.shear_angle_deg)?;
+            if a >= 60.0 {
+                return Err(invalid("test.shear_angle_deg", format!("test.shear_angle_deg = {a} is beyond any fabric's locking angle; use less than 60")));
+            }
+            need("test.speed", t.speed)?;
+        }
+        SceneKind::Arc => {
+            let k = need("test.curvature", t.curvature)?;
+            // Rolled further the strip would pass through its own clamp.
+            let most = std::f64::consts::TAU / length;
+            if k > most {
+                return Err(invalid("test.curvature", format!("test.curvature = {k:?} 1/m rolls the {length} m strip past a full circle; use at most {most:?}")));
+            }
+        }
+        SceneKind::Cantilever | SceneKind::Drape => {}
+    }
+    if let Some(v) = t.clamp_length {
+        positive_at_most("test.clamp_length", v, length, "the strip's length, cloth.length")?;
+    }
+    if kind == SceneKind::Drape {
+        check_support(c, extent)?;
+    }
+    Ok(())
+}
+
+/// The drape's clamp and support: inside the specimen, so that the drape coefficient
+/// (A_shadow − A_support)/(A_specimen − A_support) stays between 0 and 1.
+fn check_support(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
+    let t = &c.test;
+    if c.props.is_empty() {
+        return Err(invalid("props", "a drape scene needs at least one [[props]] table to drape over".into()));
+    }
+    let (cloth, disc) = (&c.cloth, c.cloth.diameter != 0.0);
+    let specimen_area = if disc { std::f64::consts::PI * cloth.diameter.powi(2) / 4.0 } else { cloth.length * cloth.width };
+    if let Some(r) = t.clamp_radius {
+        positive_at_most("test.clamp_radius", r, 0.5 * extent, "the specimen's own radius, which would leave nothing to drape")?;
+    }
+    let support_area = match (t.support_diameter, t.support_size) {
+        (Some(d), _) => {
+            positive_at_most("test.support_diameter", d, extent, "the specimen, whose drape coefficient would then exceed 1")?;
+            std::f64::consts::PI * d * d / 4.0
+        }
+        (None, Some([a, b])) => {
+            let (along_x, along_y) = if disc { (cloth.diameter, cloth.diameter) } else { (cloth.length, cloth.width) };
+            positive_at_most("test.support_size", a, along_x, "the specimen along x, whose drape coefficient would then exceed 1")?;
+            positive_at_most("test.support_size", b, along_y, "the specimen along y, whose drape coefficient would then exceed 1")?;
+            a * b
+        }
+        (None, None) => {
+            return Err(invalid("test.support_diameter", "a drape scene needs test.support_diameter (a pedestal) or test.support_size (a table top), m".into()));
+        }
+    };
+    if support_area >= specimen_area {
+        return Err(invalid(
+            if t.support_diameter.is_some() { "test.support_diameter" } else { "test.support_size" },
+            format!("the support's area {support_area:.4} m² is not smaller than the specimen's {specimen_area:.4} m²: the drape coefficient would have no meaning; use a smaller support"),
+        ));
+    }
+    Ok(())
+}
+
+fn check_contact(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
+    let k = &c.contact;
+    let key = |e: &str| e.split_whitespace().next().unwrap_or("contact").trim_end_matches(':').to_string();
+    k.validate().map_err(|e| invalid(&key(&e), e))?;
+    positive_at_most("contact.thickness", k.thickness, 0.5 * extent, "half the cloth's size: the whole cloth would float on the layer")?;
+    if let Some(v) = k.self_thickness {
+        // Thicker than an element, the layer would push every neighbour apart and list
+        // pairs by the hundred per vertex.
+        positive_at_most("contact.self_thickness", v, c.mesh.edge_length, "an element, mesh.edge_length")?;
+    }
+    positive_at_most("contact.stiffness", k.stiffness, 1e6, "the default 100 times ten thousand, where the Newton system loses its digits")?;
+    for (name, mu) in [("contact.friction_static", k.friction_static), ("contact.friction_kinetic", k.friction_kinetic)] {
+        if mu > 10.0 {
+            return Err(invalid(name, format!("{name} = {mu} is beyond any pair of surfaces (rubber on rubber is about 1); use at most 10")));
+        }
+    }
+    Ok(())
+}
