@@ -539,6 +539,13 @@ impl WorkerState {
                     self.unconverged = (self.unconverged.0 + 1, self.unconverged.1.max(report.newton_residual));
                 }
                 self.error = None;
+                if self.scene.model.triangle_count() != self.triangles.len() {
+                    // The fast path moved to a finer level: a new mesh, whose vertices the
+                    // mouse no longer holds.
+                    self.triangles = Arc::new(self.scene.model.triangles.clone());
+                    self.rest = Arc::new(self.scene.model.rest.clone());
+                    self.drag = None;
+                }
                 let end = Instant::now();
                 self.timings.push_back(StepTiming { start, end, simulated: report.dt, cpu });
                 while self.timings.front().is_some_and(|t| end.duration_since(t.start) > STATS_WINDOW) && self.timings.len() > 1 {

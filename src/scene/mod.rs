@@ -2,6 +2,7 @@
 //! One registry (`preset::SCENES`) feeds the command line, the tests and the viewer.
 
 pub mod drape;
+pub mod levels;
 pub mod measures;
 pub mod memory;
 pub mod preset;
@@ -15,7 +16,7 @@ pub use measures::Measures;
 pub use preset::{SceneConfig, SceneKind, load_scene};
 pub use run::{ContactEvents, Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
 
-use crate::sim::contact::ContactModel;
+use crate::sim::contact::{ContactModel, ContactSettings};
 use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -41,6 +42,8 @@ pub struct Scene {
     pub props: Vec<crate::sim::contact::Prop>,
     /// Steps between measurement samples.
     sample_every: u64,
+    /// The fast path's finer levels still to come (None on the exact path).
+    levels: Option<levels::Levels>,
 }
 
 /// Standard gravity, m/s².
@@ -48,27 +51,43 @@ pub const GRAVITY: f64 = 9.81;
 
 impl Scene {
     pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
-        let fabric = config.material().map_err(ModelError::from)?;
-        let props = props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
+        match levels::schedule(&config)? {
+            Some(edges) => {
+                let pending = levels::build_pending(&config, &edges[1..])?;
+                let mut scene = Self::build_level(config, Some(edges[0]))?;
+                scene.levels = Some(levels::Levels::new(&scene, pending));
+                Ok(scene)
+            }
+            None => Self::build_level(config, None),
+        }
+    }
+
+    /// The scene on its own mesh, or with `edge_length` instead of `mesh.edge_length` (a
+    /// level of the fast path's coarse-to-fine schedule, which also takes the fast path's
+    /// time step).
+    pub(crate) fn build_level(config: SceneConfig, edge_length: Option<f64>) -> Result<Self, SceneError> {
+        let level_config = levels::level_config(&config, edge_length);
+        let fabric = level_config.material().map_err(ModelError::from)?;
+        let props = props::build_props(&level_config.props, level_config.base_dir.as_deref()).map_err(SceneError::Setup)?;
         let options = PhysicsOptions {
-            membrane: config.physics.membrane,
-            bending: config.physics.bending,
-            gravity: if config.physics.gravity { DVec3::new(0.0, 0.0, -GRAVITY) } else { DVec3::ZERO },
-            damping: config.solver.damping,
+            membrane: level_config.physics.membrane,
+            bending: level_config.physics.bending,
+            gravity: if level_config.physics.gravity { DVec3::new(0.0, 0.0, -GRAVITY) } else { DVec3::ZERO },
+            damping: level_config.solver.damping,
         };
-        let c = &config.cloth;
+        let c = &level_config.cloth;
         let warp = c.warp_angle_deg.to_radians();
-        let drape = config.scene.kind == SceneKind::Drape;
-        let (mesh, clamp_band) = if drape { (drape_mesh(&config)?, 0.0) } else { strip_mesh(&config)? };
+        let drape = level_config.scene.kind == SceneKind::Drape;
+        let (mesh, clamp_band) = if drape { (drape_mesh(&level_config)?, 0.0) } else { strip_mesh(&level_config)? };
         if let Some(available) = memory::available_bytes() {
-            memory::check(mesh.rest.len(), config.mesh.edge_length, config.solver.newton.preconditioner, available).map_err(SceneError::Setup)?;
+            memory::check(mesh.rest.len(), level_config.mesh.edge_length, level_config.solver.newton.preconditioner, available).map_err(SceneError::Setup)?;
         }
         let mut model = Model::new(&mesh, &fabric, warp, options)?;
         let origin = DVec3::from_array(c.position);
         let mut x: Vec<DVec3> = mesh.rest.iter().map(|p| origin + DVec3::new(p.x, p.y, 0.0)).collect();
-        let rig = Rig::attach(&config, &mut model, &x, clamp_band)?;
-        if let Some(amplitude) = config.test.perturbation {
-            let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(config.scene.seed);
+        let rig = Rig::attach(&level_config, &mut model, &x, clamp_band)?;
+        if let Some(amplitude) = level_config.test.perturbation {
+            let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(level_config.scene.seed);
             if drape {
                 perturb_smoothly(&mut x, &model, origin, amplitude, &mut rng);
             } else {
@@ -81,15 +100,22 @@ impl Scene {
                 }
             }
         }
-        if !props.is_empty() || config.contact.self_collision {
-            model.contact = Some(ContactModel::new(props.clone(), config.contact).map_err(SceneError::Setup)?);
+        if !props.is_empty() || level_config.contact.self_collision {
+            let settings = ContactSettings { relative_motion: level_config.solver.path == levels::SolverPath::Fast, ..level_config.contact };
+            model.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
         }
-        let mut integrator = Integrator::new(config.solver.integrator, config.solver.dt);
-        integrator.newton = config.solver.newton;
-        integrator.adaptive = config.solver.adaptive;
-        let steps = (config.scene.duration / config.solver.dt).ceil().max(1.0) as u64;
+        let mut integrator = Integrator::new(level_config.solver.integrator, level_config.solver.dt);
+        integrator.newton = level_config.solver.newton;
+        integrator.adaptive = level_config.solver.adaptive;
+        let steps = (config.scene.duration / level_config.solver.dt).ceil().max(1.0) as u64;
         let sample_every = (steps / 400).max(1);
-        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every })
+        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None })
+    }
+
+    /// Whether the scene is on its own mesh: always on the exact path, and on the fast path
+    /// once its coarser levels have settled.
+    pub fn at_final_level(&self) -> bool {
+        self.levels.as_ref().is_none_or(|l| l.is_final())
     }
 
     /// Advances one step and samples the rig's measurements on schedule.
@@ -103,6 +129,7 @@ impl Scene {
         if self.state.steps.is_multiple_of(self.sample_every) {
             self.rig.sample(&self.model, &self.state);
         }
+        self.refine_if_settled();
         Ok(report)
     }
 

@@ -302,6 +302,12 @@ pub struct SolverSection {
     /// Adaptive time steps (implicit integrators), starting from `dt`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adaptive: Option<AdaptiveStep>,
+    /// The exact path (the validated reference) or the fast one.
+    #[serde(default)]
+    pub path: super::levels::SolverPath,
+    /// The fast path's settings.
+    #[serde(default)]
+    pub fast: super::levels::FastSettings,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -264,6 +264,16 @@ impl Rig {
         }
     }
 
+    /// Takes over the time series of `earlier`, the same rig on a coarser level of the fast
+    /// path, so that the history runs from the start of the scene.
+    pub fn continue_history(&mut self, earlier: Rig) {
+        match (self, earlier) {
+            (Rig::Drape(r), Rig::Drape(e)) => r.history.splice(0..0, e.history).for_each(drop),
+            (Rig::Euler(r), Rig::Euler(e)) => r.history.splice(0..0, e.history).for_each(drop),
+            _ => {}
+        }
+    }
+
     /// The rig's measurements at the end of the run.
     pub fn finish(&self, model: &Model, state: &State) -> Measures {
         match self {

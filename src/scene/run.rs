@@ -177,7 +177,6 @@ pub struct SettleWatch {
     speed: Option<f64>,
     window: f64,
     gravity_ramp: Option<f64>,
-    total_mass: f64,
     /// Start of the current run of slow steps.
     slow_since: Option<f64>,
     /// When the cloth settled: the start of the slow run that lasted the window.
@@ -191,7 +190,6 @@ impl SettleWatch {
             speed: s.settle_speed,
             window: s.settle_window,
             gravity_ramp: s.gravity_ramp,
-            total_mass: scene.model.mass.iter().sum(),
             slow_since: None,
             settled_at: None,
         }
@@ -204,7 +202,19 @@ impl SettleWatch {
 
     /// The mass-weighted RMS speed √(2 KE / M), m/s.
     pub fn rms_speed(&self, scene: &Scene) -> f64 {
-        (2.0 * scene.state.kinetic_energy(&scene.model) / self.total_mass).sqrt()
+        let total_mass: f64 = scene.model.mass.iter().sum();
+        (2.0 * scene.state.kinetic_energy(&scene.model) / total_mass).sqrt()
+    }
+
+    /// Takes the state after a step, whose RMS speed is `rms`; the time the cloth settled
+    /// once it has. On the fast path only the scene's own mesh counts (its coarser levels
+    /// settle on their way to it).
+    pub fn observe(&mut self, scene: &Scene, rms: f64) -> Option<f64> {
+        if !scene.at_final_level() {
+            self.slow_since = None;
+            return None;
+        }
+        self.observe_level(scene, rms)
     }
 
     /// Restarts the count of slow steps (something outside the scene, such as the mouse,
@@ -213,9 +223,8 @@ impl SettleWatch {
         self.slow_since = None;
     }
 
-    /// Takes the state after a step, whose RMS speed is `rms`; the time the cloth settled
-    /// once it has.
-    pub fn observe(&mut self, scene: &Scene, rms: f64) -> Option<f64> {
+    /// As `observe`, on whatever level the scene is.
+    pub(super) fn observe_level(&mut self, scene: &Scene, rms: f64) -> Option<f64> {
         let limit = self.speed?;
         if self.settled_at.is_some() {
             return self.settled_at;

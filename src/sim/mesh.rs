@@ -317,6 +317,94 @@ fn stitch_rows(
     }
 }
 
+/// Where a point of one rest plane lies on another mesh: the triangle it falls in (or, for
+/// a point outside the mesh, the nearest one) and its barycentric weights there, which sum
+/// to one and extrapolate linearly outside the triangle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Embedding {
+    pub triangle: [u32; 3],
+    pub weights: [f64; 3],
+}
+
+impl Embedding {
+    /// The embedded point's position on the mesh's deformed surface `x`.
+    pub fn position(&self, x: &[glam::DVec3]) -> glam::DVec3 {
+        let [a, b, c] = self.triangle.map(|v| x[v as usize]);
+        self.weights[0] * a + self.weights[1] * b + self.weights[2] * c
+    }
+}
+
+impl Mesh {
+    /// Embeds each of `points` (rest positions in the same sample plane) in this mesh: the
+    /// transfer from a coarse mesh's state to a finer mesh of the same specimen.
+    ///
+    /// Triangles are binned on a grid of cells about an edge wide; a point takes the
+    /// triangle that contains it, else the nearest triangle within the neighbouring cells,
+    /// widening the search until one is found (points just outside a disc's polygonal rim).
+    pub fn embed(&self, points: &[DVec2]) -> Vec<Embedding> {
+        let (lo, hi) = self.rest.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let cell = self.mean_edge_length().max(1e-9);
+        let dims = ((hi - lo) / cell).ceil().max(DVec2::ONE);
+        let (nx, ny) = (dims.x as usize, dims.y as usize);
+        let cell_of = |p: DVec2| {
+            let c = ((p - lo) / cell).floor();
+            ((c.x.max(0.0) as usize).min(nx - 1), (c.y.max(0.0) as usize).min(ny - 1))
+        };
+        let mut bins: Vec<Vec<u32>> = vec![Vec::new(); nx * ny];
+        for (t, tri) in self.triangles.iter().enumerate() {
+            let corners = tri.map(|v| self.rest[v as usize]);
+            let (a, b) = (cell_of(corners[0].min(corners[1]).min(corners[2])), cell_of(corners[0].max(corners[1]).max(corners[2])));
+            for i in a.0..=b.0 {
+                for j in a.1..=b.1 {
+                    bins[j * nx + i].push(t as u32);
+                }
+            }
+        }
+        let weights_in = |t: u32, p: DVec2| -> [f64; 3] {
+            let [a, b, c] = self.triangles[t as usize].map(|v| self.rest[v as usize]);
+            let area = (b - a).perp_dot(c - a);
+            let wb = (p - a).perp_dot(c - a) / area;
+            let wc = (b - a).perp_dot(p - a) / area;
+            [1.0 - wb - wc, wb, wc]
+        };
+        // Distance from p to the triangle in units of how far outside it lies: zero inside.
+        let outside = |w: [f64; 3]| -w[0].min(w[1]).min(w[2]).min(0.0);
+        points
+            .iter()
+            .map(|&p| {
+                let (ci, cj) = cell_of(p);
+                let mut best: Option<(f64, u32, [f64; 3])> = None;
+                for ring in 0..nx.max(ny) {
+                    let (i0, i1) = (ci.saturating_sub(ring), (ci + ring).min(nx - 1));
+                    let (j0, j1) = (cj.saturating_sub(ring), (cj + ring).min(ny - 1));
+                    for i in i0..=i1 {
+                        for j in j0..=j1 {
+                            // Only the ring's new cells.
+                            if ring > 0 && i != i0 && i != i1 && j != j0 && j != j1 {
+                                continue;
+                            }
+                            for &t in &bins[j * nx + i] {
+                                let w = weights_in(t, p);
+                                let d = outside(w);
+                                if best.is_none_or(|(bd, bt, _)| d < bd || (d == bd && t < bt)) {
+                                    best = Some((d, t, w));
+                                }
+                            }
+                        }
+                    }
+                    // Inside a triangle, or the nearest one found and the next ring can hold
+                    // nothing nearer.
+                    if best.is_some_and(|(d, _, _)| d == 0.0) || (best.is_some() && ring >= 1) {
+                        break;
+                    }
+                }
+                let (_, t, weights) = best.expect("a mesh has at least one triangle");
+                Embedding { triangle: self.triangles[t as usize], weights }
+            })
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -363,4 +451,24 @@ mod tests {
         let flipped = Mesh { rest: mesh.rest.clone(), triangles: vec![[0, 1, 3], [0, 3, 1]] };
         assert_eq!(flipped.validate(), Err(MeshError::Clockwise { triangle: 1 }));
     }
+
+    /// Embedding a fine disc in a coarse one transfers any affine deformation exactly,
+    /// inside the coarse polygon and on the fine rim just outside it.
+    #[test]
+    fn embedding_transfers_affine_deformations_exactly() {
+        let coarse = Mesh::disc(0.36, 0.03).unwrap();
+        let fine = Mesh::disc(0.36, 0.011).unwrap();
+        let map = |p: DVec2| glam::DVec3::new(1.1 * p.x - 0.3 * p.y + 0.01, 0.2 * p.x + 0.9 * p.y, 0.5 * p.x - 0.7 * p.y + 0.2);
+        let x: Vec<_> = coarse.rest.iter().map(|&p| map(p)).collect();
+        let embedded = coarse.embed(&fine.rest);
+        let mut outside = 0;
+        for (e, &p) in embedded.iter().zip(&fine.rest) {
+            assert!((e.weights.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+            outside += usize::from(e.weights.iter().any(|&w| w < -1e-12));
+            assert!((e.position(&x) - map(p)).length() < 1e-12, "at {p}");
+        }
+        // The fine rim bulges past the coarse polygon's chords.
+        assert!(outside > 0);
+    }
+
 }

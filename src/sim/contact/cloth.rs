@@ -2,7 +2,7 @@
 //! the pairs kept apart in each step's solve, and the continuous-collision fail-safe.
 
 use super::geometry::{SpatialHash, closest_point_triangle, closest_points_segments, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
-use super::{Cloth, ContactModel, PARALLEL_TRIANGLES, SelfPair, boxes_overlap, filter_in_order};
+use super::{Cloth, ContactModel, PARALLEL_TRIANGLES, SelfPair, boxes_overlap, closing_bound, filter_in_order};
 use glam::DVec3;
 
 /// Cloth–cloth pairs closer than `reach` at positions `origin` (by their bounding boxes):
@@ -23,12 +23,13 @@ pub struct NearPairs {
 impl NearPairs {
     /// Whether every pair that comes within `margin` while its vertices move at most
     /// `motion` from `start` is listed: in the worst case two vertices have closed by
-    /// twice the largest displacement since the list was built and by twice `motion`.
-    fn covers(&self, cloth: Cloth, start: &[DVec3], motion: f64, margin: f64) -> bool {
+    /// twice the largest displacement since the list was built and by twice `motion`
+    /// (both measured from the cloth's mean displacement where `relative`).
+    fn covers(&self, cloth: Cloth, start: &[DVec3], motion: f64, margin: f64, relative: bool) -> bool {
         if self.origin.len() != start.len() || self.topology != (cloth.triangles.len(), cloth.edges.len()) {
             return false;
         }
-        let moved = start.iter().zip(&self.origin).map(|(a, b)| a.distance_squared(*b)).fold(0.0, f64::max).sqrt();
+        let moved = largest_move(&self.origin, start, relative);
         2.0 * moved + 2.0 * motion + margin <= self.reach
     }
 
@@ -72,15 +73,26 @@ impl NearPairs {
     }
 }
 
+/// The largest displacement from `from` to `to`, measured from their mean displacement
+/// where `relative` (two vertices close by at most twice it either way).
+fn largest_move(from: &[DVec3], to: &[DVec3], relative: bool) -> f64 {
+    let centre = if relative && !from.is_empty() {
+        from.iter().zip(to).map(|(a, b)| *b - *a).sum::<DVec3>() / from.len() as f64
+    } else {
+        DVec3::ZERO
+    };
+    from.iter().zip(to).map(|(a, b)| ((*b - *a) - centre).length_squared()).fold(0.0, f64::max).sqrt()
+}
+
 impl ContactModel {
 
     /// The near-pair list for a search from `start` over paths of at most `motion` for
     /// pairs that come within `margin`, renewed if it does not cover them.
-    fn near_pairs<'n>(cloth: Cloth, near: &'n mut NearPairs, start: &[DVec3], motion: f64, margin: f64) -> &'n NearPairs {
+    fn near_pairs<'n>(&self, cloth: Cloth, near: &'n mut NearPairs, start: &[DVec3], motion: f64, margin: f64) -> &'n NearPairs {
         // The skin: half an edge lets a draping cloth keep its list for many steps while
         // adding few pairs beyond those in reach.
         let skin = 0.5 * cloth.mean_edge_length;
-        if !near.covers(cloth, start, motion, margin) {
+        if !near.covers(cloth, start, motion, margin, self.settings.relative_motion) {
             *near = NearPairs::build(start, cloth.triangles, cloth.edges, margin + 2.0 * motion + skin);
         }
         near
@@ -92,8 +104,9 @@ impl ContactModel {
         let (fixed, mass, triangles, edges) = (cloth.fixed, cloth.mass, cloth.triangles, cloth.edges);
         let parallel = triangles.len() >= PARALLEL_TRIANGLES;
         let delta = self.settings.self_thickness_for(cloth.mean_edge_length);
-        let motion: Vec<f64> = start.iter().zip(predicted).map(|(a, b)| a.distance(*b)).collect();
-        let near = Self::near_pairs(cloth, near, start, motion.iter().copied().fold(0.0, f64::max), delta);
+        let relative = self.settings.relative_motion;
+        let motion: Vec<DVec3> = start.iter().zip(predicted).map(|(a, b)| *b - *a).collect();
+        let near = self.near_pairs(cloth, near, start, largest_move(start, predicted, relative), delta);
         let stiffness = |m: f64| self.settings.stiffness * m / (h * h);
         let mut pairs = filter_in_order(&near.vertex_triangle, parallel, |_, &(v, t)| {
             let (vi, tri) = (v as usize, triangles[t as usize]);
@@ -101,7 +114,7 @@ impl ContactModel {
             if fixed[vi] && corners.iter().all(|&i| fixed[i]) {
                 return None;
             }
-            let reach = delta + motion[vi] + corners.iter().map(|&i| motion[i]).fold(0.0, f64::max);
+            let reach = delta + closing_bound([vi, corners[0], corners[1], corners[2]].map(|i| motion[i]), false, relative);
             // The triangle's box at the start: a vertex farther from it than the reach is
             // farther from the triangle too.
             let c = corners.map(|i| start[i]);
@@ -121,7 +134,7 @@ impl ContactModel {
             if fixed[a] && fixed[b] && fixed[c] && fixed[d] {
                 return None;
             }
-            let reach = delta + motion[a].max(motion[b]) + motion[c].max(motion[d]);
+            let reach = delta + closing_bound([a, b, c, d].map(|i| motion[i]), true, relative);
             let segment_box = |p: usize, q: usize| (start[p].min(start[q]), start[p].max(start[q]));
             if !boxes_overlap(segment_box(a, b), segment_box(c, d), reach) {
                 return None;
@@ -155,8 +168,8 @@ impl ContactModel {
         let mut stopped = 0u64;
         let mut frozen = vec![false; n];
         for _round in 0..50 {
-            let motion = start.iter().zip(end.iter()).map(|(a, b)| a.distance_squared(*b)).fold(0.0, f64::max).sqrt();
-            let crossings = find_crossings(start, end, triangles, edges, Self::near_pairs(cloth, near, start, motion, eps), eps);
+            let motion = largest_move(start, end, self.settings.relative_motion);
+            let crossings = find_crossings(start, end, triangles, edges, self.near_pairs(cloth, near, start, motion, eps), eps);
             if crossings.is_empty() {
                 break;
             }

@@ -85,6 +85,12 @@ pub struct ContactSettings {
     /// sticking cloth under a sideways pull F creep at slip_speed·F/(μN): keep it well
     /// below the speeds a scene should resolve, and below its settle speed.
     pub slip_speed: f64,
+    /// Bound how far cloth–cloth pairs can close by their vertices' motion relative to
+    /// their common motion, instead of by each vertex's own (additive CCD's centred
+    /// displacements, Li et al. 2021). Both bounds are rigorous; the centred one does not
+    /// count a falling or settling cloth's common drift, which otherwise lists every
+    /// in-plane neighbour as a pair and caps Newton's steps by it (the fast path).
+    pub relative_motion: bool,
 }
 
 impl Default for ContactSettings {
@@ -97,6 +103,7 @@ impl Default for ContactSettings {
             self_thickness: None,
             stiffness: 100.0,
             slip_speed: 1e-3,
+            relative_motion: false,
         }
     }
 }
@@ -182,6 +189,8 @@ pub struct StepContacts {
     self_thickness: f64,
     /// Slip threshold over the step, m.
     slip: f64,
+    /// Step limits by centred displacements (`ContactSettings::relative_motion`).
+    relative_motion: bool,
 }
 
 impl ContactModel {
@@ -229,6 +238,7 @@ impl ContactModel {
             thickness: s.thickness,
             self_thickness: s.self_thickness_for(cloth.mean_edge_length),
             slip: s.slip_speed * h,
+            relative_motion: s.relative_motion,
         };
         let per_vertex = filter_in_order(start, parallel, |v, _| {
             let mut planes = Vec::new();
@@ -399,6 +409,16 @@ fn filter_in_order<T: Sync, U: Send>(items: &[T], parallel: bool, keep: impl Fn(
         })
         .collect();
     parts.into_iter().flatten().collect()
+}
+
+/// How far a pair's gap can close when its four vertices move by `d` (vertex then triangle
+/// corners, or one edge's ends then the other's): each side's largest move, measured from
+/// `centre` (the triangle inequality holds for any centre; zero gives each vertex's own
+/// move, the pair's mean leaves out their common motion).
+fn closing_bound(d: [DVec3; 4], edge_edge: bool, relative: bool) -> f64 {
+    let centre = if relative { 0.25 * (d[0] + d[1] + d[2] + d[3]) } else { DVec3::ZERO };
+    let v = d.map(|di| (di - centre).length());
+    if edge_edge { v[0].max(v[1]) + v[2].max(v[3]) } else { v[0] + v[1].max(v[2]).max(v[3]) }
 }
 
 /// Whether two boxes come within `margin` of each other.

@@ -1,7 +1,7 @@
 //! The contacts of one step as energies in the implicit solve: their potential, gradient,
 //! Hessian and couplings, and the step limits that keep cloth–cloth pairs from meeting.
 
-use super::{SelfPair, StepContacts};
+use super::{SelfPair, StepContacts, closing_bound};
 use super::geometry::{closest_point_triangle, closest_points_segments};
 use crate::sim::linalg::{BlockCsr, Coupling};
 use glam::{DMat3, DVec3};
@@ -177,8 +177,7 @@ impl StepContacts {
     pub fn step_limit(&self, y: &[DVec3], d: &[DVec3]) -> f64 {
         let mut alpha = f64::INFINITY;
         for p in &self.pairs {
-            let v = p.vertices.map(|i| d[i as usize].length());
-            let bound = if p.edge_edge { v[0].max(v[1]) + v[2].max(v[3]) } else { v[0] + v[1].max(v[2]).max(v[3]) };
+            let bound = closing_bound(p.vertices.map(|i| d[i as usize]), p.edge_edge, self.relative_motion);
             if bound > 0.0 {
                 let (gap, _, _) = self.self_distance(p, y);
                 alpha = alpha.min(0.9 * gap / bound);

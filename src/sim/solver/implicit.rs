@@ -89,6 +89,7 @@ impl Integrator {
         for i in 0..n {
             s.v[i] = (y[i] - anchor[i]) / h;
         }
+        self.step_error = (0..n).filter(|&i| !model.fixed[i]).map(|i| 0.5 * dt * (s.v[i] - previous.1[i]).length()).fold(0.0, f64::max);
         if let Some(contacts) = &step_contacts {
             // A vertex whose rebound was absorbed gets a history of steady motion at its new
             // velocity, or BDF2's extrapolation from its falling past would lift it again.

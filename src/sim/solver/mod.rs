@@ -128,6 +128,9 @@ pub struct Integrator {
     shift: f64,
     /// The last shift that a failure had to be raised to: where the next failure starts.
     needed_shift: f64,
+    /// Implicit Euler's local error estimate of the last step, ½h·max|v_{n+1} − v_n| over
+    /// the free vertices, m (`NewtonSettings::error_share`).
+    step_error: f64,
 }
 
 impl Integrator {
@@ -145,6 +148,7 @@ impl Integrator {
             near_pairs: NearPairs::default(),
             shift: 0.0,
             needed_shift: 0.0,
+            step_error: 0.0,
         }
     }
 

@@ -37,7 +37,8 @@ pub(super) struct NewtonProblem<'a> {
 }
 
 impl<'a> NewtonProblem<'a> {
-    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64) -> Self {
+    /// Newton's tolerance is `tolerance` mean edges, or `loose` metres where that is more.
+    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64, loose: f64) -> Self {
         let ImplicitStep { model, h, .. } = *step;
         let zeta = model.options.damping;
         let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
@@ -46,7 +47,7 @@ impl<'a> NewtonProblem<'a> {
         // where the cloth buckles unless the compression outweighs inertia.
         let softening = mass_diagonal.iter().zip(&model.fixed).map(|(&d, &f)| if f { f64::INFINITY } else { SOFTENING_SHARE * d }).collect();
         let all_free = !model.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
-        Self { step, contacts, mass_diagonal, softening, tolerance: tolerance * model.mean_edge_length, all_free }
+        Self { step, contacts, mass_diagonal, softening, tolerance: (tolerance * model.mean_edge_length).max(loose), all_free }
     }
 
     /// Φ at `y`, contact included.
@@ -107,7 +108,7 @@ impl Integrator {
     /// Newton's method on the incremental potential Φ (plus contact), from `y` in place.
     pub(super) fn newton(&mut self, step: &ImplicitStep, contacts: Option<&StepContacts>, y: &mut Vec<DVec3>, report: &mut StepReport) {
         let model = step.model;
-        let problem = NewtonProblem::new(step, contacts, self.newton.tolerance);
+        let problem = NewtonProblem::new(step, contacts, self.newton.tolerance, self.newton.error_share * self.step_error);
         let n = y.len();
         let mut work = NewtonWork {
             stiffness: model.stiffness_matrix(),
@@ -118,7 +119,7 @@ impl Integrator {
             trial: y.clone(),
             couplings: Vec::new(),
         };
-        let mut history = NewtonHistory::default();
+        let mut history = NewtonHistory { bounded_throughout: std::env::var_os("ROSETTE_BOUNDED").is_some(), ..NewtonHistory::default() };
         let mut watch = Stopwatch::start();
         report.newton_unconverged = true;
         for _ in 0..self.newton.max_iterations {
@@ -324,6 +325,10 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
         }
     }
     history.phi_current = Some(phi).filter(|_| accepted);
+    if std::env::var_os("ROSETTE_TRACE").is_some() {
+        let gn = gradient.iter().map(|g| g.length_squared()).sum::<f64>().sqrt();
+        eprintln!("NEWTON |g|={gn:.3e} len={length:.3e} alpha={alpha:.3e} limit={limit:.3e} accepted={accepted} dphi={:.3e} slope={slope:.3e}", phi - phi0);
+    }
     watch.forces();
     let step_size = alpha * length;
     history.previous_step = Some(step_size);

@@ -1,0 +1,160 @@
+//! The fast path's coarse-to-fine settling of drapes.
+//!
+//! A drape is an equilibrium reached along a slow path, and the path is where the exact
+//! run spends its time: thousands of Newton iterations on the user's mesh while the cloth
+//! sinks, buckles at the rim and folds. The fold pattern is decided at a scale set by the
+//! fabric's bending length, far above a fine mesh's edges. The fast path therefore takes
+//! the path on a coarse mesh of the same specimen and only settles on the finer ones:
+//!
+//! ```text
+//!   coarsest mesh: lowered from flat under the gravity ramp, until it settles
+//!        │ positions and velocities carried over (barycentric, rest plane)
+//!   mesh at half that edge: settles
+//!        │
+//!   the scene's own mesh: settles; the run stops there, as the exact path does
+//! ```
+//!
+//! Each level halves the edge of the one before, so the transfer leaves every level only
+//! the folds its coarser neighbour could not resolve to relax. All levels run at the fast
+//! path's time step (`solver.fast.dt`), on which implicit Euler is as stable as on the
+//! exact path's.
+
+use super::preset::SceneKind;
+use super::run::SettleWatch;
+use super::{Scene, SceneConfig, SceneError};
+use crate::sim::{Mesh, PreconditionerChoice};
+use serde::{Deserialize, Serialize};
+
+/// Which step design a scene runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum SolverPath {
+    /// The validated reference: the scene's own mesh and time step from start to end.
+    #[default]
+    Exact,
+    /// Model no more of the path than the result needs: drapes settle coarse to fine at the
+    /// fast path's time step (see the module documentation).
+    Fast,
+}
+
+/// Settings of the fast path (`[solver.fast]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FastSettings {
+    /// Time step of every level, s.
+    pub dt: f64,
+    /// Largest edge of the coarsest level as a share of the fabric's bending length
+    /// (B/w)^(1/3): coarse enough to be cheap, fine enough that folds, whose width scales
+    /// with the bending length, span several elements.
+    pub coarsest_edge_share: f64,
+    /// Newton stops at a step under this share of the step's own integration error
+    /// (`solver.newton.error_share`; the exact path's tolerance still holds at rest).
+    pub error_share: f64,
+}
+
+impl Default for FastSettings {
+    fn default() -> Self {
+        Self { dt: 0.016, coarsest_edge_share: 0.5, error_share: 0.1 }
+    }
+}
+
+/// The edge lengths of the fast path's levels, coarsest first and the scene's own last;
+/// None where the scene runs on its own mesh throughout (the exact path, or a scene that
+/// does not settle).
+pub fn schedule(config: &SceneConfig) -> Result<Option<Vec<f64>>, SceneError> {
+    let solver = &config.solver;
+    if solver.path != SolverPath::Fast || config.scene.kind != SceneKind::Drape || config.scene.settle_speed.is_none() {
+        return Ok(None);
+    }
+    let fabric = config.fabric.to_fabric().map_err(crate::sim::ModelError::from)?;
+    let weight = fabric.weight_per_area(super::GRAVITY);
+    let bending_length = (fabric.bending_warp.min(fabric.bending_weft) / weight).cbrt();
+    let coarsest = solver.fast.coarsest_edge_share * bending_length;
+    let mut edges = vec![config.mesh.edge_length];
+    while 2.0 * edges[0] <= coarsest {
+        edges.insert(0, 2.0 * edges[0]);
+    }
+    Ok(Some(edges))
+}
+
+/// The configuration of one level: the scene's own, on a mesh of `edge_length` and at the
+/// fast path's time step; the scene's own unchanged for None.
+pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConfig {
+    let mut level = config.clone();
+    if let Some(edge) = edge_length {
+        level.mesh.edge_length = edge;
+        level.solver.dt = config.solver.fast.dt;
+        level.solver.newton.error_share = config.solver.fast.error_share;
+        // At the fast path's steps the incomplete factor leaves CG tens of iterations per
+        // Newton iteration even on coarse meshes; the complete factor a few.
+        if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
+            level.solver.newton.preconditioner = PreconditionerChoice::Cholesky;
+        }
+    }
+    level
+}
+
+/// The finer levels still to come and the settling of the current one.
+pub struct Levels {
+    /// Finer levels, next first, each built when the scene was, so that a bad mesh is
+    /// refused before any work.
+    pending: Vec<Scene>,
+    /// The current level's settling.
+    watch: SettleWatch,
+}
+
+impl Levels {
+    pub fn new(current: &Scene, pending: Vec<Scene>) -> Self {
+        Self { pending, watch: SettleWatch::new(current) }
+    }
+
+    /// Whether the current level is the scene's own mesh.
+    pub fn is_final(&self) -> bool {
+        self.pending.is_empty()
+    }
+}
+
+impl Scene {
+    /// After a step on a coarse level: moves to the next finer level once the current one
+    /// has settled.
+    pub(super) fn refine_if_settled(&mut self) {
+        let Some(mut levels) = self.levels.take() else { return };
+        if !levels.is_final() {
+            let rms = levels.watch.rms_speed(self);
+            if levels.watch.observe_level(self, rms).is_some() {
+                let next = levels.pending.remove(0);
+                self.continue_on(next);
+                levels.watch = SettleWatch::new(self);
+            }
+        }
+        self.levels = Some(levels);
+    }
+
+    /// Carries this level's cloth over to `next`, the same scene on a finer mesh, and takes
+    /// its place: positions and velocities by barycentric transfer in the rest plane (its
+    /// clamped vertices keep their own prescribed places), time, step count, contact
+    /// statistics and the rig's history.
+    fn continue_on(&mut self, mut next: Scene) {
+        let coarse = Mesh { rest: self.model.rest.clone(), triangles: self.model.triangles.clone() };
+        for (i, e) in coarse.embed(&next.model.rest).iter().enumerate() {
+            if !next.model.fixed[i] {
+                next.state.x[i] = e.position(&self.state.x);
+                next.state.v[i] = e.position(&self.state.v);
+            }
+        }
+        next.state.time = self.state.time;
+        next.state.steps = self.state.steps;
+        next.integrator.contact_stats = self.integrator.contact_stats;
+        self.model = next.model;
+        self.state = next.state;
+        self.integrator = next.integrator;
+        self.sample_every = next.sample_every;
+        let earlier = std::mem::replace(&mut self.rig, next.rig);
+        self.rig.continue_history(earlier);
+    }
+}
+
+/// Builds the finer levels of `schedule` (coarsest first, already built, excluded).
+pub fn build_pending(config: &SceneConfig, finer: &[f64]) -> Result<Vec<Scene>, SceneError> {
+    finer.iter().map(|&edge| Scene::build_level(config.clone(), Some(edge))).collect()
+}
