@@ -91,7 +91,7 @@ pub struct Stats {
     /// Conjugate-gradient iterations of the last step.
     pub cg_iterations: usize,
     /// Steps since the scene started whose Newton solve stopped short of its tolerance (by
-    /// more than `run::UNCONVERGED_FACTOR`), as `rosette run` counts them against exit 5.
+    /// more than `UNCONVERGED_FACTOR`), as `rosette run` counts them against exit 5.
     pub unconverged_steps: u64,
     /// The largest of those steps' last Newton step over the mean edge length.
     pub worst_residual: f64,
@@ -535,7 +535,7 @@ impl WorkerState {
         match result {
             Ok(report) => {
                 self.last_report = report;
-                if report.newton_residual > crate::scene::run::UNCONVERGED_FACTOR * self.scene.integrator.newton.tolerance {
+                if !report.converged() {
                     self.unconverged = (self.unconverged.0 + 1, self.unconverged.1.max(report.newton_residual));
                 }
                 self.error = None;

@@ -25,8 +25,9 @@ pub struct Metrics {
     /// False where a step diverged (`error` says how); the run stopped there.
     pub stable: bool,
     /// Whether every step's Newton solve converged: its last Newton step was within
-    /// `UNCONVERGED_FACTOR` times `solver.newton.tolerance`. A run that is stable but not
-    /// converged has results that the solver's limits, not the physics, decided.
+    /// `UNCONVERGED_FACTOR` times the tolerance it stopped at (`StepReport::converged`).
+    /// A run that is stable but not converged has results that the solver's limits, not
+    /// the physics, decided.
     pub converged: bool,
     /// Steps that stopped at Newton's iteration limit (or left a contact unresolved after
     /// four solves).
@@ -111,10 +112,6 @@ pub struct RunOptions<'a> {
     pub max_wall_seconds: Option<f64>,
 }
 
-/// A step's Newton solve counts as converged when its last step was at most this many
-/// times the tolerance: Newton itself accepts that much when its line search can no longer
-/// lower the energy (round-off), so only a solve cut short by its iteration limit exceeds it.
-pub const UNCONVERGED_FACTOR: f64 = 10.0;
 
 /// One step of a run: what it cost and how fast the cloth moved (`rosette run --step-log`).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -260,7 +257,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let mut error = None;
     let mut settle = SettleWatch::new(scene);
     let mut k = 0u64;
-    let (mut limit_steps, mut worst_residual) = (0u64, 0.0f64);
+    let (mut limit_steps, mut worst_residual, mut unconverged) = (0u64, 0.0f64, 0u64);
     let mut stopped_at_limit = None;
     let max_steps = options.max_steps.unwrap_or(scene.config.scene.max_steps);
     // Steps until the end time is reached (a fixed Δt that does not divide the duration
@@ -289,6 +286,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         rejected += report.rejected as u64;
         limit_steps += u64::from(report.newton_unconverged);
         worst_residual = worst_residual.max(report.newton_residual);
+        unconverged += u64::from(!report.converged());
         let rms = settle.rms_speed(scene);
         if let Some(f) = on_step.as_deref_mut() {
             f(&StepRecord {
@@ -328,7 +326,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         cpu_seconds_per_simulated_second: per_second,
         cpu_seconds_per_10ms: per_second * 0.01,
         stable: error.is_none(),
-        converged: worst_residual <= UNCONVERGED_FACTOR * scene.integrator.newton.tolerance,
+        converged: unconverged == 0,
         newton_limit_steps: limit_steps,
         worst_residual,
         stopped_at_limit,

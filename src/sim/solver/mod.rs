@@ -23,7 +23,7 @@ mod preconditioning;
 mod report;
 mod settings;
 
-pub use report::{StepError, StepReport, StepTimings};
+pub use report::{StepError, StepReport, StepTimings, UNCONVERGED_FACTOR};
 pub use settings::{AdaptiveStep, NewtonSettings, PreconditionerChoice};
 
 use crate::sim::contact::{ContactModel, ContactStats, NearPairs};

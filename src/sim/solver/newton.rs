@@ -119,7 +119,7 @@ impl Integrator {
             trial: y.clone(),
             couplings: Vec::new(),
         };
-        let mut history = NewtonHistory { bounded_throughout: std::env::var_os("ROSETTE_BOUNDED").is_some(), ..NewtonHistory::default() };
+        let mut history = NewtonHistory::default();
         let mut watch = Stopwatch::start();
         report.newton_unconverged = true;
         for _ in 0..self.newton.max_iterations {
@@ -145,6 +145,7 @@ impl Integrator {
         }
         report.timings += watch.timings;
         report.newton_residual = history.previous_step.map_or(f64::INFINITY, |step| step / model.mean_edge_length);
+        report.newton_tolerance = problem.tolerance / model.mean_edge_length;
     }
 
     /// ∇Φ at `y` into `gradient` (zero on fixed vertices), and its norm.
@@ -325,10 +326,6 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
         }
     }
     history.phi_current = Some(phi).filter(|_| accepted);
-    if std::env::var_os("ROSETTE_TRACE").is_some() {
-        let gn = gradient.iter().map(|g| g.length_squared()).sum::<f64>().sqrt();
-        eprintln!("NEWTON |g|={gn:.3e} len={length:.3e} alpha={alpha:.3e} limit={limit:.3e} accepted={accepted} dphi={:.3e} slope={slope:.3e}", phi - phi0);
-    }
     watch.forces();
     let step_size = alpha * length;
     history.previous_step = Some(step_size);

@@ -26,8 +26,11 @@ pub struct StepReport {
     /// True when Newton stopped at its iteration limit before reaching its tolerance.
     pub newton_unconverged: bool,
     /// Newton's last step (the largest vertex move) over the mean edge length: below
-    /// `NewtonSettings::tolerance` where Newton converged, 0 for the explicit integrator.
+    /// `newton_tolerance` where Newton converged, 0 for the explicit integrator.
     pub newton_residual: f64,
+    /// The tolerance this step's Newton solve stopped at, over the mean edge length:
+    /// `NewtonSettings::tolerance`, or more where `NewtonSettings::error_share` loosened it.
+    pub newton_tolerance: f64,
     /// Where the step's time went.
     pub timings: StepTimings,
     /// The time step taken, s.
@@ -39,7 +42,18 @@ pub struct StepReport {
     pub shift: f64,
 }
 
+/// A step's Newton solve counts as converged when its last step was at most this many
+/// times its tolerance: Newton itself accepts that much when its line search can no longer
+/// lower the energy (round-off), so only a solve cut short by its iteration limit exceeds it.
+pub const UNCONVERGED_FACTOR: f64 = 10.0;
+
 impl StepReport {
+    /// Whether the step's Newton solve converged (within `UNCONVERGED_FACTOR` of its
+    /// tolerance; always for the explicit integrator).
+    pub fn converged(&self) -> bool {
+        self.newton_residual <= UNCONVERGED_FACTOR * self.newton_tolerance
+    }
+
     /// Adds another attempt's work (iterations and time).
     pub(super) fn add_work(&mut self, other: &StepReport) {
         self.newton_iterations += other.newton_iterations;
