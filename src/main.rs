@@ -56,6 +56,10 @@ enum Command {
         /// Wall-clock seconds after which the run stops, keeping what it has (exit 6).
         #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_MAX_WALL)]
         max_wall: f64,
+        /// Take the fast path (solver.path = "fast"): settling scenes settle coarse to fine,
+        /// with longer steps and Newton solved to the step's own accuracy (docs/solvers.md).
+        #[arg(long)]
+        fast: bool,
         #[command(flatten)]
         screenshot: ScreenshotArgs,
     },
@@ -96,6 +100,13 @@ enum Command {
         /// Exit after drawing N frames (smoke tests).
         #[arg(long, value_name = "N")]
         quit_after_frames: Option<u64>,
+        /// Override a scene value, e.g. --set mesh.edge_length=0.0075 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<String>,
+        /// Take the fast path (solver.path = "fast"): settling scenes settle coarse to fine,
+        /// with longer steps and Newton solved to the step's own accuracy (docs/solvers.md).
+        #[arg(long)]
+        fast: bool,
     },
 }
 
@@ -160,6 +171,9 @@ const EXIT_STOPPED: u8 = 6;
 /// `rosette fabric check`: a virtual test read a sheet value outside its tolerance.
 const EXIT_READBACK: u8 = 7;
 
+/// What `--fast` adds to a scene's overrides.
+const FAST_PATH: &str = "solver.path=fast";
+
 /// A day: longer than any bundled scene takes, short enough that a runaway run ends.
 const DEFAULT_MAX_WALL: f64 = 86_400.0;
 
@@ -181,8 +195,13 @@ fn main() -> ExitCode {
             eprintln!("wrote cusick-drape.png; `rosette run PRESET --screenshot FILE.png` for other scenes");
             code
         }
-        None => view(ViewerOptions { preset: None, quit_after_frames: cli.quit_after_frames }),
-        Some(Command::View { preset, quit_after_frames }) => view(ViewerOptions { preset, quit_after_frames }),
+        None => view(ViewerOptions { preset: None, quit_after_frames: cli.quit_after_frames, overrides: Vec::new() }),
+        Some(Command::View { preset, quit_after_frames, mut overrides, fast }) => {
+            if fast {
+                overrides.push(FAST_PATH.to_string());
+            }
+            view(ViewerOptions { preset, quit_after_frames, overrides })
+        }
         Some(Command::Presets) => {
             for (name, description) in preset::scene_descriptions() {
                 println!("{name:<16} {description}");
@@ -198,7 +217,10 @@ fn main() -> ExitCode {
         },
         Some(Command::Chart { out, quick }) => chart(out, quick),
         Some(Command::Fabric { action }) => fabric(action),
-        Some(Command::Run { preset, overrides, duration, metrics, outline, step_log, max_steps, max_wall, screenshot }) => {
+        Some(Command::Run { preset, mut overrides, duration, metrics, outline, step_log, max_steps, max_wall, fast, screenshot }) => {
+            if fast {
+                overrides.push(FAST_PATH.to_string());
+            }
             let outputs = RunOutputs { metrics: metrics.as_deref(), outline: outline.as_deref(), step_log: step_log.as_deref() };
             run(&preset, &overrides, &RunLimits { duration, max_steps, max_wall }, &outputs, &screenshot)
         }

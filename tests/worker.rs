@@ -165,6 +165,27 @@ fn solver_change_keeps_the_state() {
     assert!(worker.sync(WAIT).error.as_deref().is_some_and(|e| e.contains("solver.dt")));
 }
 
+/// Regression: the viewer's solver change rebuilt the integrator by hand and dropped the
+/// scene's adaptive step control (and `max_stretch` and the contact statistics with it).
+/// With adaptive steps on, three steps from a new Δt no longer add up to three times it.
+#[test]
+fn solver_change_keeps_adaptive_steps() {
+    let (config, _) = load_scene("cantilever", &["solver.adaptive.tolerance=1e-3".into()]).unwrap();
+    assert!(config.solver.adaptive.is_some_and(|a| a.enabled));
+    let worker = spawn("cantilever", config);
+    worker.send(Command::Step);
+    let before = worker.sync(WAIT);
+    worker.send(Command::SetSolver { dt: 0.002, integrator: IntegratorKind::ImplicitEuler });
+    for _ in 0..3 {
+        worker.send(Command::Step);
+    }
+    let after = worker.sync(WAIT);
+    assert_eq!(after.steps, before.steps + 3);
+    let fixed = before.time + 3.0 * 0.002;
+    assert!((after.time - fixed).abs() > 1e-9, "the steps kept Δt fixed at 0.002 s: adaptive steps were dropped");
+    assert!(after.config.solver.adaptive.is_some());
+}
+
 #[test]
 fn fabric_change_restarts_and_a_bad_fabric_is_reported() {
     let worker = spawn("cantilever", preset("cantilever"));

@@ -10,6 +10,7 @@ use super::plots::{self, History};
 use super::worker::{Command, Snapshot};
 use crate::scene::preset::{FABRICS, FabricConfig, SCENES, scene_descriptions};
 use crate::scene::load_scene;
+use crate::scene::levels::SolverPath;
 use crate::sim::IntegratorKind;
 use egui::{Color32, Key, PointerButton, Rect, Sense};
 use egui_plot::{Legend, Line, MarkerShape, Plot, PlotPoints, Points};
@@ -282,9 +283,26 @@ impl ViewerUi {
             ui.label("time step dt");
             ui.add(relative_drag(&mut dt).range(1e-6..=0.1).suffix(" s"));
             ui.end_row();
+            ui.label("path");
+            let mut path = snapshot.config.solver.path;
+            ui.horizontal(|ui| {
+                ui.selectable_value(&mut path, SolverPath::Exact, "exact")
+                    .on_hover_text("The validated reference: the scene's own mesh and time step throughout.");
+                ui.selectable_value(&mut path, SolverPath::Fast, "fast").on_hover_text(
+                    "Settling scenes settle coarse to fine, with longer steps and Newton solved to the step's own accuracy; \
+                     the drape coefficient stays within the exact path's seed scatter (docs/solvers.md).",
+                );
+            });
+            if path != snapshot.config.solver.path {
+                actions.push(Action::Send(Command::SetPath(path)));
+            }
+            ui.end_row();
         });
         if dt != snapshot.config.solver.dt || integrator != snapshot.config.solver.integrator {
             actions.push(Action::Send(Command::SetSolver { dt, integrator }));
+        }
+        if snapshot.coarse_level {
+            ui.small("Fast path: a coarser level of the mesh; the scene's own mesh follows once it settles.");
         }
         if integrator.is_explicit() {
             ui.small("Symplectic Euler is stable only below its limit; a diverged step is reported and the last state kept.");

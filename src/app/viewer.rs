@@ -29,6 +29,8 @@ pub struct ViewerOptions {
     pub preset: Option<String>,
     /// Exit (status 0) after drawing this many frames: for smoke tests and scripted runs.
     pub quit_after_frames: Option<u64>,
+    /// `KEY=VALUE` overrides of the first scene, as `rosette run --set` takes them.
+    pub overrides: Vec<String>,
 }
 
 /// The scene the viewer opens on: the Cusick drape where it exists, else Euler buckling.
@@ -56,7 +58,7 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
         return Err(anyhow!(NO_DISPLAY));
     }
     let spec = options.preset.clone().unwrap_or_else(|| default_scene().to_string());
-    let (config, _) = load_scene(&spec, &[]).map_err(|e| anyhow!("{e}"))?;
+    let (config, _) = load_scene(&spec, &options.overrides).map_err(|e| anyhow!("{e}"))?;
     let event_loop = EventLoop::<Wake>::with_user_event()
         .build()
         .map_err(|e| anyhow!("cannot connect to the display ({e}). {NO_DISPLAY}"))?;

@@ -13,7 +13,8 @@
 //! real-time factor. Nothing here depends on a GUI crate, so tests drive it directly.
 
 use crate::scene::{Measures, Scene, SceneConfig, SettleWatch, load_scene, preset::FabricConfig};
-use crate::sim::{Integrator, IntegratorKind, State};
+use crate::scene::levels::SolverPath;
+use crate::sim::IntegratorKind;
 use glam::DVec3;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -45,6 +46,9 @@ pub enum Command {
     /// Changes the time step (s) and integrator, keeping the current positions, velocities
     /// and time. The BDF2 history is dropped: its formula assumes the old step.
     SetSolver { dt: f64, integrator: IntegratorKind },
+    /// Switches between the exact and the fast solver path and restarts the scene from
+    /// t = 0 (the fast path builds its coarser levels), keeping play/pause.
+    SetPath(SolverPath),
     /// Holds `vertex` at a point moving towards `target` (m) by at most [`DRAG_SPEED`]·dt
     /// and half an edge per step, so a fast mouse cannot tear the mesh in one step. A second
     /// drag of another vertex releases the first.
@@ -145,6 +149,8 @@ pub struct Snapshot {
     pub error: Option<String>,
     /// The vertex held by the mouse, if any.
     pub dragged: Option<u32>,
+    /// The fast path is on one of its coarser levels (the scene's own mesh comes next).
+    pub coarse_level: bool,
 }
 
 /// The shared one-slot mailbox: the newest snapshot, and a condition variable for callers
@@ -419,6 +425,12 @@ impl WorkerState {
                 self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(format!("fabric not applied: {e}")));
             }
             Command::SetSolver { dt, integrator } => self.set_solver(dt, integrator),
+            Command::SetPath(path) => {
+                let mut config = self.scene.config.clone();
+                config.solver.path = path;
+                let playing = self.playing;
+                self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(format!("solver path not applied: {e}")));
+            }
             Command::DragVertex { vertex, target } => self.drag(vertex, target),
             Command::ReleaseDrag => self.release_drag(),
             Command::RunTest(name) => match load_scene(&name, &[]) {
@@ -466,22 +478,10 @@ impl WorkerState {
     }
 
     fn set_solver(&mut self, dt: f64, integrator: IntegratorKind) {
-        if !(dt.is_finite() && dt > 0.0) {
-            self.error = Some(format!("solver.dt must be a positive number of seconds, got {dt}"));
+        if let Err(e) = self.scene.set_solver(dt, integrator) {
+            self.error = Some(e.to_string());
             return;
         }
-        let newton = self.scene.integrator.newton;
-        self.scene.integrator = Integrator::new(integrator, dt);
-        self.scene.integrator.newton = newton;
-        self.scene.config.solver.dt = dt;
-        self.scene.config.solver.integrator = integrator;
-        // A fresh State has no BDF2 history; positions, velocities and time carry over.
-        let old = &self.scene.state;
-        let mut state = State::at_rest(old.x.clone());
-        state.v = old.v.clone();
-        state.time = old.time;
-        state.steps = old.steps;
-        self.scene.state = state;
         self.config = Arc::new(self.scene.config.clone());
         self.pace = (Instant::now(), self.scene.state.time);
         self.timings.clear();
@@ -619,6 +619,7 @@ impl WorkerState {
             measures: Arc::new(self.scene.measures()),
             error: self.error.clone(),
             dragged: self.drag.as_ref().map(|d| d.vertex),
+            coarse_level: !self.scene.at_final_level(),
         };
         *self.mailbox.slot.lock().expect("mailbox lock") = Some(Arc::new(snapshot));
         self.mailbox.published.notify_all();

@@ -19,7 +19,6 @@
 //! path's time step (`solver.fast.dt`), on which implicit Euler is as stable as on the
 //! exact path's.
 
-use super::preset::SceneKind;
 use super::run::SettleWatch;
 use super::{Scene, SceneConfig, SceneError};
 use crate::sim::{Mesh, PreconditionerChoice};
@@ -59,14 +58,22 @@ impl Default for FastSettings {
 }
 
 /// The edge lengths of the fast path's levels, coarsest first and the scene's own last;
-/// None where the scene runs on its own mesh throughout (the exact path, or a scene that
-/// does not settle).
+/// None where the scene runs on its own mesh and settings throughout: the exact path, and
+/// on the fast path a scene that does not settle (the laboratory rigs, whose loads are
+/// the experiment).
 pub fn schedule(config: &SceneConfig) -> Result<Option<Vec<f64>>, SceneError> {
     let solver = &config.solver;
-    if solver.path != SolverPath::Fast || config.scene.kind != SceneKind::Drape || config.scene.settle_speed.is_none() {
+    if solver.path != SolverPath::Fast || config.scene.settle_speed.is_none() {
         return Ok(None);
     }
-    let fabric = config.fabric.to_fabric().map_err(crate::sim::ModelError::from)?;
+    if solver.integrator.is_explicit() {
+        return Err(SceneError::Setup(
+            "solver.path = \"fast\" takes implicit steps, which solver.integrator = \"symplectic-euler\" cannot; \
+             use solver.integrator = \"implicit-euler\" or solver.path = \"exact\""
+                .into(),
+        ));
+    }
+    let fabric = config.material().map_err(crate::sim::ModelError::from)?;
     let weight = fabric.weight_per_area(super::GRAVITY);
     let bending_length = (fabric.bending_warp.min(fabric.bending_weft) / weight).cbrt();
     let coarsest = solver.fast.coarsest_edge_share * bending_length;
@@ -77,14 +84,26 @@ pub fn schedule(config: &SceneConfig) -> Result<Option<Vec<f64>>, SceneError> {
     Ok(Some(edges))
 }
 
-/// The configuration of one level: the scene's own, on a mesh of `edge_length` and at the
-/// fast path's time step; the scene's own unchanged for None.
+/// Whether the scene loads its cloth slowly enough for the fast path's long steps: no
+/// props to land on, or props with gravity ramped up (a lowered specimen). A cloth dropped
+/// onto a prop keeps the scene's own step, because the penalty layer stops a vertex arriving
+/// at speed v within about v·Δt/√c (c the contact stiffness factor, 100), which longer steps
+/// would let exceed the contact thickness.
+fn quasi_static(config: &SceneConfig) -> bool {
+    config.props.is_empty() || config.scene.gravity_ramp.is_some()
+}
+
+/// The configuration of one level: the scene's own, on a mesh of `edge_length` with the
+/// fast path's settings; the scene's own unchanged for None.
 pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConfig {
     let mut level = config.clone();
     if let Some(edge) = edge_length {
+        let fast = &config.solver.fast;
         level.mesh.edge_length = edge;
-        level.solver.dt = config.solver.fast.dt;
-        level.solver.newton.error_share = config.solver.fast.error_share;
+        if quasi_static(config) {
+            level.solver.dt = config.solver.dt.max(fast.dt);
+        }
+        level.solver.newton.error_share = fast.error_share;
         // At the fast path's steps the incomplete factor leaves CG tens of iterations per
         // Newton iteration even on coarse meshes; the complete factor a few.
         if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
@@ -149,6 +168,7 @@ impl Scene {
         self.state = next.state;
         self.integrator = next.integrator;
         self.sample_every = next.sample_every;
+        self.level_edge = next.level_edge;
         let earlier = std::mem::replace(&mut self.rig, next.rig);
         self.rig.continue_history(earlier);
     }

@@ -44,6 +44,9 @@ pub struct Scene {
     sample_every: u64,
     /// The fast path's finer levels still to come (None on the exact path).
     levels: Option<levels::Levels>,
+    /// The edge length of the fast path's level the scene is on (None: the scene's own
+    /// mesh and settings).
+    level_edge: Option<f64>,
 }
 
 /// Standard gravity, m/s².
@@ -104,12 +107,27 @@ impl Scene {
             let settings = ContactSettings { relative_motion: level_config.solver.path == levels::SolverPath::Fast, ..level_config.contact };
             model.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
         }
-        let mut integrator = Integrator::new(level_config.solver.integrator, level_config.solver.dt);
-        integrator.newton = level_config.solver.newton;
-        integrator.adaptive = level_config.solver.adaptive;
+        let integrator = level_config.solver.integrator();
         let steps = (config.scene.duration / level_config.solver.dt).ceil().max(1.0) as u64;
         let sample_every = (steps / 400).max(1);
-        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None })
+        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length })
+    }
+
+    /// Changes the time step (s) and integrator, keeping positions, velocities, time and
+    /// what contact has counted; every other solver setting (Newton, adaptive steps, the
+    /// fast path's level) stays as the scene's configuration has it. BDF2's history starts
+    /// afresh, as it must at a new step.
+    pub fn set_solver(&mut self, dt: f64, kind: crate::sim::IntegratorKind) -> Result<(), SceneError> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(SceneError::Setup(format!("solver.dt must be a positive number of seconds, got {dt}")));
+        }
+        self.config.solver.dt = dt;
+        self.config.solver.integrator = kind;
+        let mut integrator = levels::level_config(&self.config, self.level_edge).solver.integrator();
+        integrator.contact_stats = self.integrator.contact_stats;
+        self.integrator = integrator;
+        self.state.clear_history();
+        Ok(())
     }
 
     /// Whether the scene is on its own mesh: always on the exact path, and on the fast path

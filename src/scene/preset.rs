@@ -310,6 +310,16 @@ pub struct SolverSection {
     pub fast: super::levels::FastSettings,
 }
 
+impl SolverSection {
+    /// The integrator these settings describe: the one place a scene's integrator is made.
+    pub fn integrator(&self) -> crate::sim::Integrator {
+        let mut integrator = crate::sim::Integrator::new(self.integrator, self.dt);
+        integrator.newton = self.newton;
+        integrator.adaptive = self.adaptive;
+        integrator
+    }
+}
+
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsSection {

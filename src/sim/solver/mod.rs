@@ -55,6 +55,11 @@ impl State {
         Self { x, v, time: 0.0, steps: 0, previous: None }
     }
 
+    /// Forgets the previous step (BDF2's history), as a change of time step requires.
+    pub fn clear_history(&mut self) {
+        self.previous = None;
+    }
+
     /// Kinetic energy, J.
     pub fn kinetic_energy(&self, model: &Model) -> f64 {
         self.v.iter().zip(&model.mass).map(|(v, m)| 0.5 * m * v.length_squared()).sum()
