@@ -78,7 +78,9 @@ pub struct ArcMeasures {
     pub curvature: f64,
     /// Bending moment per unit width at midspan, N·m/m.
     pub moment: f64,
-    /// Moment over curvature, N·m; absent (JSON null) while the strip is straight.
+    /// Moment over curvature, N·m; absent while the strip is straight (JSON has no
+    /// infinity, and a null would pass for a number).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rigidity: Option<f64>,
 }
 
@@ -89,6 +91,7 @@ pub struct EulerMeasures {
     pub compression_speed: f64,
     /// End force when the strip first buckled (see `critical_load_definition`), N/m;
     /// absent until it has.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub critical_load: Option<f64>,
     /// [`EulerMeasures::CRITICAL_LOAD_DEFINITION`].
     pub critical_load_definition: String,
@@ -151,6 +154,7 @@ pub struct DrapeMeasures {
     /// Largest radius of the shadow's outline from the support's centre, m.
     pub outline_radius_max: f64,
     /// Smallest radius of the outline, m; absent when the outline is empty.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub outline_radius_min: Option<f64>,
     /// Area of the vertical projection of the cloth, m².
     pub shadow_area: f64,
