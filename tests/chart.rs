@@ -3,6 +3,7 @@
 //! the explicit limit 2/ω_max computed from each model: symplectic Euler diverges above it
 //! and stays bounded below it, while the implicit integrators stay bounded at those steps.
 
+use rosette::scene::levels::SolverPath;
 use rosette::chart::{ChartOptions, INACCURATE_ERROR, Plan, Problem, Progress, Status};
 use rosette::sim::IntegratorKind;
 use std::path::Path;
@@ -43,7 +44,7 @@ fn quick_chart_writes_its_tables_and_pictures_and_explicit_runs_fail_above_their
 
     // The CSV files: their headers, and one row per planned run.
     let accuracy = lines(&out.join("accuracy.csv"));
-    assert_eq!(accuracy[0], "problem,integrator,dt,dt_over_limit,edge_length,triangles,cpu_seconds,error,status,pareto");
+    assert_eq!(accuracy[0], "problem,integrator,path,dt,dt_over_limit,edge_length,triangles,cpu_seconds,error,status,pareto");
     assert_eq!(accuracy.len() - 1, plan.accuracy.len());
     let stability = lines(&out.join("stability.csv"));
     assert_eq!(
@@ -80,6 +81,16 @@ fn quick_chart_writes_its_tables_and_pictures_and_explicit_runs_fail_above_their
         let best = report.accuracy.iter().filter(|r| r.problem == problem).filter_map(|r| r.error).fold(f64::INFINITY, f64::min);
         println!("{}: best error {best:.3e}", problem.name());
         assert!(best < INACCURATE_ERROR, "{}: best error {best}", problem.name());
+    }
+
+    // The fast path is charted beside exact Newton on the cantilever's mesh, and lands on
+    // the same elastica: its error is the mesh's, not the path's.
+    let fast: Vec<_> = report.accuracy.iter().filter(|r| r.path == SolverPath::Fast).collect();
+    assert!(fast.iter().any(|r| r.problem == Problem::Cantilever), "no fast-path cantilever in the quick sweep");
+    for r in &fast {
+        let error = r.error.unwrap_or_else(|| panic!("fast path on {}: {}", r.problem.name(), r.status));
+        println!("{} fast path: error {error:.3e} in {:.3} CPU s", r.problem.name(), r.cpu_seconds);
+        assert!(error < INACCURATE_ERROR, "{} fast path: error {error}", r.problem.name());
     }
 
     let (w, h) = rosette::chart::plot::PANEL;

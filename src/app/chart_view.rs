@@ -7,6 +7,7 @@
 
 use crate::chart::data::{AccuracyRow, StabilityRow, parse_accuracy, parse_stability, read_accuracy, read_stability};
 use crate::chart::{ChartError, ChartOptions, ChartReport, Plan, Problem, Progress, StabilityMap, Status};
+use crate::scene::levels::SolverPath;
 use crate::sim::IntegratorKind;
 use egui::Color32;
 use egui_plot::{GridMark, Legend, Line, MarkerShape, Plot, PlotPoints, Points};
@@ -345,19 +346,31 @@ impl ChartView {
             .y_axis_formatter(log_axis)
             .show(ui, |plot| {
                 for kind in IntegratorKind::ALL {
-                    let mut edges: Vec<f64> = rows.iter().filter(|r| r.integrator == kind).map(|r| r.edge_length).collect();
+                    let exact = |r: &&&AccuracyRow| r.integrator == kind && r.path == SolverPath::Exact;
+                    let mut edges: Vec<f64> = rows.iter().filter(exact).map(|r| r.edge_length).collect();
                     edges.sort_by(f64::total_cmp);
                     edges.dedup();
                     for edge in edges {
                         let mut points: Vec<[f64; 2]> = rows
                             .iter()
-                            .filter(|r| r.integrator == kind && r.edge_length == edge)
+                            .filter(exact)
+                            .filter(|r| r.edge_length == edge)
                             .filter_map(|r| log_point(r.cpu_seconds, r.error?))
                             .collect();
                         points.sort_by(|a, b| a[0].total_cmp(&b[0]));
                         plot.line(Line::new(kind.name(), PlotPoints::from(points.clone())).color(integrator_colour(kind)).width(2.0));
                         plot.points(Points::new(kind.name(), PlotPoints::from(points)).color(integrator_colour(kind)).radius(3.0));
                     }
+                }
+                // The fast path: one run per mesh, joined from coarse to fine.
+                let mut fast: Vec<[f64; 2]> =
+                    rows.iter().filter(|r| r.path == SolverPath::Fast).filter_map(|r| log_point(r.cpu_seconds, r.error?)).collect();
+                if !fast.is_empty() {
+                    fast.sort_by(|a, b| a[0].total_cmp(&b[0]));
+                    let c = crate::chart::plot::FAST_PATH_COLOUR;
+                    let colour = Color32::from_rgb(c.0, c.1, c.2);
+                    plot.line(Line::new("fast path", PlotPoints::from(fast.clone())).color(colour).width(2.0));
+                    plot.points(Points::new("fast path", PlotPoints::from(fast)).color(colour).shape(MarkerShape::Up).radius(5.0));
                 }
                 let mut front: Vec<[f64; 2]> = rows.iter().filter(|r| r.pareto).filter_map(|r| log_point(r.cpu_seconds, r.error?)).collect();
                 front.sort_by(|a, b| a[0].total_cmp(&b[0]));
@@ -478,6 +491,7 @@ mod tests {
             .map(|(cpu, error)| AccuracyRow {
                 problem: Problem::Tensile,
                 integrator: IntegratorKind::Bdf2,
+                path: SolverPath::Exact,
                 dt: 0.01,
                 dt_over_limit: 300.0,
                 edge_length: 0.01,

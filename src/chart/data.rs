@@ -3,11 +3,12 @@
 
 use super::sweep::{Case, Outcome, Problem, Status};
 use super::{ChartError, StabilityMap};
+use crate::scene::levels::SolverPath;
 use crate::sim::IntegratorKind;
 use std::fmt::Write as _;
 use std::path::Path;
 
-pub const ACCURACY_HEADER: &str = "problem,integrator,dt,dt_over_limit,edge_length,triangles,cpu_seconds,error,status,pareto";
+pub const ACCURACY_HEADER: &str = "problem,integrator,path,dt,dt_over_limit,edge_length,triangles,cpu_seconds,error,status,pareto";
 pub const STABILITY_HEADER: &str = "map,problem,integrator,dt,explicit_limit_dt,dt_over_limit,tensile_scale,bending_scale,tensile_stiffness,bending_stiffness,triangles,cpu_seconds,error,status";
 
 /// One run of the accuracy chart.
@@ -15,6 +16,8 @@ pub const STABILITY_HEADER: &str = "map,problem,integrator,dt,explicit_limit_dt,
 pub struct AccuracyRow {
     pub problem: Problem,
     pub integrator: IntegratorKind,
+    /// The exact solver path or the fast one (`solver.path`).
+    pub path: SolverPath,
     /// Time step, s.
     pub dt: f64,
     /// The time step over the explicit stability limit of the same model.
@@ -89,6 +92,7 @@ pub fn accuracy_rows(outcomes: &[Outcome]) -> Vec<AccuracyRow> {
         .map(|o| AccuracyRow {
             problem: o.case.problem,
             integrator: o.case.integrator,
+            path: o.case.path,
             dt: o.dt,
             dt_over_limit: o.dt / o.explicit_limit,
             edge_length: o.case.edge_length,
@@ -138,9 +142,10 @@ pub fn write_accuracy(path: &Path, rows: &[AccuracyRow]) -> Result<(), ChartErro
     for r in rows {
         let _ = writeln!(
             text,
-            "{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{}",
             r.problem.name(),
             r.integrator.name(),
+            r.path.name(),
             number(Some(r.dt)),
             number(Some(r.dt_over_limit)),
             r.edge_length,
@@ -234,14 +239,15 @@ pub fn parse_accuracy(text: &str, origin: &Path) -> Result<Vec<AccuracyRow>, Cha
                 Ok(AccuracyRow {
                     problem: Problem::from_name(&f[0]).ok_or(format!("unknown problem `{}`", f[0]))?,
                     integrator: parse_integrator(&f[1]).ok_or(format!("unknown integrator `{}`", f[1]))?,
-                    dt: parse_number(&f[2])?,
-                    dt_over_limit: parse_number(&f[3])?,
-                    edge_length: parse_number(&f[4])?,
-                    triangles: f[5].parse().map_err(|_| format!("`{}` is not a count", f[5]))?,
-                    cpu_seconds: parse_number(&f[6])?,
-                    error: parse_optional(&f[7])?,
-                    status: f[8].clone(),
-                    pareto: f[9] == "true",
+                    path: SolverPath::from_name(&f[2]).ok_or(format!("unknown solver path `{}`", f[2]))?,
+                    dt: parse_number(&f[3])?,
+                    dt_over_limit: parse_number(&f[4])?,
+                    edge_length: parse_number(&f[5])?,
+                    triangles: f[6].parse().map_err(|_| format!("`{}` is not a count", f[6]))?,
+                    cpu_seconds: parse_number(&f[7])?,
+                    error: parse_optional(&f[8])?,
+                    status: f[9].clone(),
+                    pareto: f[10] == "true",
                 })
             };
             row().map_err(|message| ChartError::Read { path: origin.to_path_buf(), message: format!("line {}: {message}", i + 2) })
@@ -314,6 +320,7 @@ mod tests {
         AccuracyRow {
             problem: Problem::Cantilever,
             integrator: IntegratorKind::ImplicitEuler,
+            path: SolverPath::Exact,
             dt: 0.01,
             dt_over_limit: 100.0,
             edge_length: 0.005,

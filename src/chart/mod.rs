@@ -13,6 +13,7 @@ pub mod sweep;
 pub use data::{AccuracyRow, StabilityRow};
 pub use sweep::{Case, INACCURATE_ERROR, Outcome, Problem, Status, Step};
 
+use crate::scene::levels::SolverPath;
 use crate::sim::IntegratorKind;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -152,7 +153,7 @@ pub struct Plan {
 }
 
 fn case(problem: Problem, integrator: IntegratorKind, step: Step, edge_length: f64) -> Case {
-    Case { problem, integrator, step, edge_length, tensile_scale: 1.0, bending_scale: 1.0 }
+    Case { problem, integrator, path: SolverPath::Exact, step, edge_length, tensile_scale: 1.0, bending_scale: 1.0 }
 }
 
 impl Plan {
@@ -190,6 +191,12 @@ impl Plan {
                 }
                 if i == 0 && !quick && problem != Problem::Drape {
                     accuracy.push(case(problem, SymplecticEuler, Step::OfLimit(0.45), edge));
+                }
+                // The equilibrium problems on the fast path, at its own step, beside exact
+                // Newton on the same meshes.
+                if matches!(problem, Problem::Cantilever | Problem::Drape) {
+                    let fast_step = crate::scene::levels::FastSettings::default().dt;
+                    accuracy.push(Case { path: SolverPath::Fast, ..case(problem, ImplicitEuler, Step::Seconds(fast_step), edge) });
                 }
             }
         }

@@ -5,6 +5,7 @@
 use super::data::{AccuracyRow, StabilityRow};
 use super::sweep::{Problem, Status};
 use super::StabilityMap;
+use crate::scene::levels::SolverPath;
 use crate::sim::IntegratorKind;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -21,6 +22,9 @@ fn register_font() {
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT);
     });
 }
+
+/// The fast solver path's runs in the accuracy panels.
+pub const FAST_PATH_COLOUR: RGBColor = RGBColor(230, 120, 0);
 
 pub fn integrator_colour(kind: IntegratorKind) -> RGBColor {
     match kind {
@@ -143,14 +147,14 @@ fn accuracy_panel(panel: &Panel, problem: Problem, rows: &[&AccuracyRow]) -> Dra
         .draw()?;
     for kind in IntegratorKind::ALL {
         let colour = integrator_colour(kind);
-        let mut edges: Vec<f64> = plotted.iter().filter(|r| r.integrator == kind).map(|r| r.edge_length).collect();
+        let mut edges: Vec<f64> = plotted.iter().filter(|r| r.integrator == kind && r.path == SolverPath::Exact).map(|r| r.edge_length).collect();
         edges.sort_by(f64::total_cmp);
         edges.dedup();
         let mut labelled = false;
         for edge in edges {
             let mut curve: Vec<(f64, f64)> = plotted
                 .iter()
-                .filter(|r| r.integrator == kind && r.edge_length == edge)
+                .filter(|r| r.integrator == kind && r.path == SolverPath::Exact && r.edge_length == edge)
                 .map(|r| (r.cpu_seconds, r.error.unwrap_or(0.0)))
                 .collect();
             curve.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -161,6 +165,17 @@ fn accuracy_panel(panel: &Panel, problem: Problem, rows: &[&AccuracyRow]) -> Dra
             }
             chart.draw_series(curve.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
         }
+    }
+    // The fast path: one run per mesh, joined from coarse to fine.
+    let mut fast: Vec<(f64, f64)> =
+        plotted.iter().filter(|r| r.path == SolverPath::Fast).map(|r| (r.cpu_seconds, r.error.unwrap_or(0.0))).collect();
+    if !fast.is_empty() {
+        fast.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(fast.clone(), FAST_PATH_COLOUR.stroke_width(2)))?
+            .label("fast path")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], FAST_PATH_COLOUR.stroke_width(2)));
+        chart.draw_series(fast.iter().map(|&p| TriangleMarker::new(p, 5, FAST_PATH_COLOUR.filled())))?;
     }
     let mut front: Vec<(f64, f64)> = plotted.iter().filter(|r| r.pareto).map(|r| (r.cpu_seconds, r.error.unwrap_or(0.0))).collect();
     front.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -4,6 +4,7 @@
 
 use crate::reference::{euler_elastica_from_shortening, heavy_cantilever};
 use crate::scene::{GRAVITY, Measures, RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use crate::scene::levels::SolverPath;
 use crate::sim::IntegratorKind;
 use glam::DVec3;
 
@@ -98,6 +99,8 @@ pub enum Step {
 pub struct Case {
     pub problem: Problem,
     pub integrator: IntegratorKind,
+    /// The exact solver path or the fast one.
+    pub path: SolverPath,
     pub step: Step,
     /// Mesh edge length, m.
     pub edge_length: f64,
@@ -140,6 +143,9 @@ impl Case {
         };
         let millimetres = (self.edge_length * 1e4).round() / 10.0;
         let mut label = format!("{} {} {step}, {millimetres} mm edges", self.problem.name(), self.integrator);
+        if self.path == SolverPath::Fast {
+            label += ", fast path";
+        }
         if self.tensile_scale != 1.0 {
             label += &format!(", tensile x{}", self.tensile_scale);
         }
@@ -154,6 +160,7 @@ impl Case {
         let mut overrides: Vec<String> = self.problem.overrides().iter().map(|s| s.to_string()).collect();
         overrides.push(format!("mesh.edge_length={}", self.edge_length));
         overrides.push(format!("solver.integrator={}", self.integrator.name()));
+        overrides.push(format!("solver.path={}", self.path.name()));
         overrides.push(format!("solver.dt={dt}"));
         // An explicit run at a fraction of its stability limit takes as many steps as that
         // needs (tens of millions on the stiffest maps): the sweep's cases are bounded by
@@ -348,6 +355,7 @@ mod tests {
         let case = Case {
             problem: Problem::Tensile,
             integrator: IntegratorKind::Bdf2,
+            path: SolverPath::Exact,
             step: Step::Seconds(0.01),
             edge_length: 0.01,
             tensile_scale: 1.0,

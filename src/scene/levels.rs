@@ -36,6 +36,22 @@ pub enum SolverPath {
     Fast,
 }
 
+impl SolverPath {
+    pub const ALL: [SolverPath; 2] = [SolverPath::Exact, SolverPath::Fast];
+
+    /// The name as typed in scene files and CSV tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverPath::Exact => "exact",
+            SolverPath::Fast => "fast",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+}
+
 /// Settings of the fast path (`[solver.fast]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
