@@ -23,6 +23,9 @@ struct Case {
     duration: Option<f64>,
     /// The paper's Table 1 CPU seconds per 10 ms, where it has this scene.
     paper: Option<f64>,
+    /// Thread counts this case runs with (of those asked for); None: all of them. The whole
+    /// fine drapes run on the two threads their targets are stated on.
+    threads: Option<&'static [usize]>,
 }
 
 /// One measured run.
@@ -48,6 +51,15 @@ pub struct BenchRow {
     pub cg_per_newton: f64,
     pub peak_memory_mb: f64,
     pub paper_cpu_seconds_per_10ms: Option<f64>,
+    /// `exact` or `fast` (`solver.path`).
+    pub path: String,
+    /// The drape scenes' coefficient and nodes at the end of the run.
+    pub drape_coefficient: Option<f64>,
+    pub nodes: Option<usize>,
+    /// The run stopped because the cloth settled.
+    pub settled: Option<bool>,
+    pub max_penetration: Option<f64>,
+    pub self_intersections: Option<usize>,
 }
 
 /// Triangles of a `cusick-drape` disc at edge length `edge` are about 875·(0.0155/edge)².
@@ -62,15 +74,42 @@ fn cases(quick: bool) -> Vec<Case> {
         overrides,
         duration,
         paper,
+        threads: None,
     };
     let mut out = vec![
         case("tensile-bias", "tensile-bias", vec![], Some(if quick { 0.5 } else { 6.0 }), Some(8.06)),
         case("euler-buckling", "euler-buckling", vec![], Some(if quick { 0.2 } else { 8.0 }), Some(1.39)),
         case("shear-buckling", "shear-buckling", vec![], Some(if quick { 0.2 } else { 2.2 }), Some(9.58)),
     ];
-    if !quick {
-        // The whole drape, to settling: the paper's Fig. 6 scene.
+    // Whole runs to a settled cloth, each on the exact path and the fast one, side by side:
+    // what a user waits for.
+    let both = |out: &mut Vec<Case>, name: &str, preset, overrides: Vec<String>, duration, threads| {
+        for path in PATHS {
+            let mut o = overrides.clone();
+            o.push(format!("solver.path={path}"));
+            out.push(Case { threads, ..case(&format!("{name}, {path}"), preset, o, duration, None) });
+        }
+    };
+    let edge = |e: f64| vec![format!("mesh.edge_length={e:.5}")];
+    if quick {
+        both(&mut out, "cusick-drape, to settling", "cusick-drape", vec![], None, None);
+    } else {
+        // The paper's Fig. 6 scene, against Table 1.
         out.push(case("cusick-drape, to settling", "cusick-drape", vec![], None, Some(9.36)));
+        both(&mut out, "cusick-drape 7.5 mm, to settling", "cusick-drape", edge(0.0075), None, None);
+        both(&mut out, "cusick-drape ~20000 tri, to settling", "cusick-drape", edge(0.00315), None, Some(&[2]));
+        // The fast path's growth with the mesh, whole runs (the exact path's growth is the
+        // two-step rows below: its whole runs at 80 000 triangles take hours).
+        for n in [5000.0, 80000.0] {
+            let name = format!("cusick-drape ~{} tri, to settling, fast", n as u64);
+            let mut o = edge(drape_edge_for(n));
+            o.push("solver.path=fast".into());
+            out.push(Case { threads: Some(&[2]), ..case(&name, "cusick-drape", o, None, None) });
+        }
+        // Cloth dropped onto props: the tablecloth to settling, and the peers' drop of a
+        // 1 m² cloth onto a sphere over its first 0.4 s (the fall and the wrap), on one thread.
+        both(&mut out, "tablecloth, to settling", "tablecloth", vec![], None, None);
+        both(&mut out, "sphere-drop, first 0.4 s", "sphere-drop", vec![], Some(0.4), Some(&[1]));
     }
     // The same window for every size, so that their costs compare: the first two 4 ms
     // steps of the lowering (gravity ramps up over 2 s), short enough for 80 000 triangles
@@ -92,6 +131,9 @@ fn cases(quick: bool) -> Vec<Case> {
     }
     out
 }
+
+/// The solver paths the whole runs compare (`solver.path`).
+const PATHS: [&str; 2] = ["exact", "fast"];
 
 /// The global preconditioners the drape sizes are run with (`solver.newton.preconditioner`).
 const SOLVERS: [&str; 2] = ["cholesky", "multigrid"];
@@ -132,6 +174,12 @@ fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
         cg_per_newton: m.cg_iterations as f64 / newton.max(1.0),
         peak_memory_mb: m.peak_memory_bytes.map_or(f64::NAN, |b| b as f64) / 1e6,
         paper_cpu_seconds_per_10ms: case.paper,
+        path: if case.overrides.iter().any(|o| o == "solver.path=fast") { "fast" } else { "exact" }.to_string(),
+        drape_coefficient: m.measures.drape().map(|d| d.drape_coefficient),
+        nodes: m.measures.drape().map(|d| d.nodes),
+        settled: m.settled,
+        max_penetration: m.max_penetration,
+        self_intersections: m.self_intersections,
     })
 }
 
@@ -145,7 +193,7 @@ pub fn run(out: &Path, quick: bool, threads: &[usize]) -> Result<Vec<BenchRow>> 
         "case", "thr", "tris", "CPU s/s", "wall s/s", "forces", "solve", "contact", "newton", "cg/nwt", "peak MB"
     );
     for case in cases(quick) {
-        for &t in threads {
+        for &t in threads.iter().filter(|t| case.threads.is_none_or(|only| only.contains(t))) {
             let row = run_case(&exe, &case, t)?;
             println!(
                 "{:<46} {:>3} {:>7} {:>10.4} {:>10.4} {:>5.0}% {:>5.0}% {:>6.0}% {:>7.2} {:>7.1} {:>8.1}",
@@ -212,6 +260,36 @@ fn summarise(rows: &[BenchRow]) {
             );
         }
     }
+    // The fast path against the exact one on the same scene and threads: time to a settled
+    // cloth, and what it settled on.
+    for fast in rows.iter().filter(|r| r.path == "fast") {
+        let exact_case = fast.case.replace(", fast", ", exact");
+        let Some(exact) = rows.iter().find(|o| o.case == exact_case && o.threads == fast.threads) else { continue };
+        let drape = |r: &BenchRow| r.drape_coefficient.map_or(String::new(), |dc| format!(", DC {dc:.3} with {} nodes", r.nodes.unwrap_or(0)));
+        println!(
+            "{}, {} thread(s): fast path {:.1} s wall ({:.2}x real time{}) against exact {:.1} s ({}): {:.1}x faster",
+            fast.case.trim_end_matches(", fast"),
+            fast.threads,
+            fast.wall_seconds,
+            fast.simulated_seconds / fast.wall_seconds,
+            drape(fast),
+            exact.wall_seconds,
+            drape(exact).trim_start_matches(", "),
+            exact.wall_seconds / fast.wall_seconds
+        );
+    }
+    // The fast path's growth: wall seconds per simulated second of whole runs against the
+    // triangle count, between each pair of sizes.
+    let mut growth: Vec<&BenchRow> =
+        rows.iter().filter(|r| r.path == "fast" && r.case.starts_with("cusick-drape ~") && r.case.contains("to settling")).collect();
+    growth.sort_by_key(|r| r.triangles);
+    for pair in growth.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        if a.threads == b.threads && b.triangles > a.triangles {
+            let exponent = (b.wall_seconds_per_simulated_second / a.wall_seconds_per_simulated_second).ln() / (b.triangles as f64 / a.triangles as f64).ln();
+            println!("fast path: wall s per simulated s grows as (triangles)^{exponent:.2} from {} to {} triangles", a.triangles, b.triangles);
+        }
+    }
     // Multigrid against the complete factor at each size and thread count (wall time).
     for r in rows.iter().filter(|r| r.case.ends_with(SOLVERS[1])) {
         let direct_case = r.case.replace(SOLVERS[1], SOLVERS[0]);
@@ -227,12 +305,12 @@ fn write_csv(path: &Path, rows: &[BenchRow]) -> Result<()> {
         f,
         "case,threads,triangles,vertices,steps,simulated_seconds,wall_seconds,cpu_seconds_per_simulated_second,\
          wall_seconds_per_simulated_second,forces_share,solve_share,contact_share,solver_speedup_bound,newton_per_step,cg_per_newton,\
-         peak_memory_mb,paper_cpu_seconds_per_10ms"
+         peak_memory_mb,paper_cpu_seconds_per_10ms,path,drape_coefficient,nodes,settled,max_penetration,self_intersections"
     )?;
     for r in rows {
         writeln!(
             f,
-            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.case,
             r.threads,
             r.triangles,
@@ -249,7 +327,13 @@ fn write_csv(path: &Path, rows: &[BenchRow]) -> Result<()> {
             r.newton_per_step,
             r.cg_per_newton,
             r.peak_memory_mb,
-            r.paper_cpu_seconds_per_10ms.map_or(String::new(), |p| p.to_string())
+            r.paper_cpu_seconds_per_10ms.map_or(String::new(), |p| p.to_string()),
+            r.path,
+            r.drape_coefficient.map_or(String::new(), |v| v.to_string()),
+            r.nodes.map_or(String::new(), |v| v.to_string()),
+            r.settled.map_or(String::new(), |v| v.to_string()),
+            r.max_penetration.map_or(String::new(), |v| v.to_string()),
+            r.self_intersections.map_or(String::new(), |v| v.to_string())
         )?;
     }
     Ok(())

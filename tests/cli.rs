@@ -359,7 +359,7 @@ fn bench_quick_writes_one_row_per_case() {
     }
     // The case name is quoted (it may hold commas); the columns after it are numbers.
     let rows: Vec<Vec<&str>> = lines.map(|l| l[l.rfind("\",").expect("a quoted case") + 2..].split(',').collect()).collect();
-    assert_eq!(rows.len(), 7, "three Table 1 scenes and two drape sizes with two solvers each:\n{csv}");
+    assert_eq!(rows.len(), 9, "three Table 1 scenes, the drape to settling on both solver paths, and two drape sizes with two solvers each:\n{csv}");
     let column = |row: &Vec<&str>, key: &str| -> f64 {
         let i = header.iter().position(|h| *h == key).unwrap();
         row[i - 1].parse().unwrap_or(f64::NAN)
@@ -376,12 +376,20 @@ fn bench_quick_writes_one_row_per_case() {
     }
     let stdout = text(&output.stdout);
     assert!(stdout.contains("no solver can make this run more than"), "no solver bound printed:\n{stdout}");
-    // The drapes (the last four rows: each size with the complete factor, then with
-    // multigrid) are the only cases with contact; a size's two rows are the same mesh, and
-    // the larger size has more triangles.
-    assert!(column(&rows[3], "contact_share") > 0.0 && column(&rows[0], "contact_share") == 0.0);
-    assert_eq!(column(&rows[3], "triangles"), column(&rows[4], "triangles"));
-    assert!(column(&rows[5], "triangles") > 4.0 * column(&rows[3], "triangles"));
+    // The drapes (the two whole runs, then the last four rows: each size with the complete
+    // factor, then with multigrid) are the only cases with contact; a size's two rows are
+    // the same mesh, and the larger size has more triangles.
+    assert!(column(&rows[5], "contact_share") > 0.0 && column(&rows[0], "contact_share") == 0.0);
+    assert_eq!(column(&rows[5], "triangles"), column(&rows[6], "triangles"));
+    assert!(column(&rows[7], "triangles") > 4.0 * column(&rows[5], "triangles"));
     let names: Vec<&str> = csv.lines().skip(1).map(|l| &l[1..l.rfind("\",").unwrap()]).collect();
-    assert!(names[3].ends_with("cholesky") && names[4].ends_with("multigrid"), "{names:?}");
+    assert!(names[5].ends_with("cholesky") && names[6].ends_with("multigrid"), "{names:?}");
+    // The whole drape on both paths: the same mesh, both settled on a coefficient.
+    assert!(names[3].ends_with(", exact") && names[4].ends_with(", fast"), "{names:?}");
+    assert_eq!(column(&rows[3], "triangles"), column(&rows[4], "triangles"));
+    for row in &rows[3..5] {
+        assert_eq!(row[row.len() - 3], "true", "settled: {row:?}");
+        let dc = column(row, "drape_coefficient");
+        assert!(dc > 0.0 && dc < 1.0, "{row:?}");
+    }
 }

@@ -28,7 +28,7 @@ macro_rules! bundled {
 /// Bundled scenes; their file stems are the names users type.
 pub const SCENES: &[Bundled] = bundled!("";
     "tensile-warp", "tensile-weft", "tensile-bias", "cantilever", "arc", "euler-buckling", "shear-buckling",
-    "cusick-drape", "cusick-drape-30", "tablecloth");
+    "cusick-drape", "cusick-drape-30", "tablecloth", "sphere-drop");
 
 /// Bundled fabrics.
 pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk", "wool-plain-fast", "wool-worsted", "wool-flannel", "cotton-poplin", "cotton-oxford", "cotton-lawn", "denim-14oz");

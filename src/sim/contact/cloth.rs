@@ -327,9 +327,15 @@ mod tests {
     use glam::DVec2;
     use std::collections::BTreeSet;
 
-    /// Every pair the step's search must find, by testing all of them.
-    fn all_pairs(model: &Model, start: &[DVec3], predicted: &[DVec3], delta: f64) -> BTreeSet<([u32; 4], bool)> {
-        let motion = |i: usize| start[i].distance(predicted[i]);
+    /// Every pair the step's search must find, by testing all of them: those whose gap at
+    /// the start is under δ plus how far the pair can close, each side's largest move
+    /// (measured from the pair's mean move where `relative`).
+    fn all_pairs(model: &Model, start: &[DVec3], predicted: &[DVec3], delta: f64, relative: bool) -> BTreeSet<([u32; 4], bool)> {
+        let moves = |ids: [usize; 4]| {
+            let d = ids.map(|i| predicted[i] - start[i]);
+            let centre = if relative { (d[0] + d[1] + d[2] + d[3]) / 4.0 } else { DVec3::ZERO };
+            d.map(|di| (di - centre).length())
+        };
         let mut found = BTreeSet::new();
         for (v, &p) in start.iter().enumerate() {
             for tri in &model.triangles {
@@ -337,7 +343,8 @@ mod tests {
                     continue;
                 }
                 let c = tri.map(|i| i as usize);
-                let reach = delta + motion(v) + c.iter().map(|&i| motion(i)).fold(0.0, f64::max);
+                let m = moves([v, c[0], c[1], c[2]]);
+                let reach = delta + m[0] + m[1].max(m[2]).max(m[3]);
                 let (q, _) = closest_point_triangle(p, start[c[0]], start[c[1]], start[c[2]]);
                 if (q - p).length() < reach {
                     found.insert(([v as u32, tri[0], tri[1], tri[2]], false));
@@ -350,7 +357,8 @@ mod tests {
                     continue;
                 }
                 let [a, b, c, d] = [a, b, c, d].map(|i| i as usize);
-                let reach = delta + motion(a).max(motion(b)) + motion(c).max(motion(d));
+                let m = moves([a, b, c, d]);
+                let reach = delta + m[0].max(m[1]) + m[2].max(m[3]);
                 let (s, t) = closest_points_segments(start[a], start[b], start[c], start[d]);
                 if (start[a].lerp(start[b], s) - start[c].lerp(start[d], t)).length() < reach {
                     found.insert(([a, b, c, d].map(|i| i as u32), true));
@@ -364,25 +372,38 @@ mod tests {
     /// list, kept or renewed, must give exactly the pairs an exhaustive search gives.
     #[test]
     fn near_pair_list_finds_every_pair_an_exhaustive_search_finds() {
-        let total = folded_strip_pairs(0.004, 12);
+        let total = folded_strip_pairs(0.004, 12, false, 0.0);
         assert!(total > 100, "the fold should bring many pairs within reach: {total}");
+    }
+
+    /// The same with the bound on how far a pair can close taken from the pair's own motion
+    /// relative to its mean (the fast path), while the whole strip also falls: the list,
+    /// kept over steps by the cloth's motion about its mean, still misses no pair, and the
+    /// common fall no longer brings every in-plane neighbour into it.
+    #[test]
+    fn centred_motion_misses_no_pair_and_ignores_the_common_fall() {
+        let relative = folded_strip_pairs(0.004, 12, true, 0.003);
+        let absolute = folded_strip_pairs(0.004, 12, false, 0.003);
+        assert!(relative > 100, "the fold should still bring many pairs within reach: {relative}");
+        assert!(relative < absolute, "centred: {relative} pairs, each vertex's own move: {absolute}");
     }
 
     /// The same on a mesh of over `PARALLEL_TRIANGLES` triangles, whose searches run in
     /// chunks on rayon's threads.
     #[test]
     fn searches_in_parallel_find_every_pair_too() {
-        let total = folded_strip_pairs(0.00058, 2);
+        let total = folded_strip_pairs(0.00058, 2, false, 0.0);
         assert!(total > 1000, "the fold should bring many pairs within reach: {total}");
     }
 
-    /// Pairs over `steps` steps of the folded strip meshed at `edge`, checked against the
-    /// exhaustive search; returns how many there were.
-    fn folded_strip_pairs(edge: f64, steps: usize) -> usize {
+    /// Pairs over `steps` steps of the folded strip meshed at `edge` and falling `fall` m a
+    /// step, with the closing bound centred where `relative`, checked against the exhaustive
+    /// search; returns how many there were.
+    fn folded_strip_pairs(edge: f64, steps: usize, relative: bool, fall: f64) -> usize {
         let mesh = Mesh::rectangle(0.04, 0.02, edge, Pattern::Regular, 0).unwrap();
         let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
         assert_eq!(model.triangles.len() >= PARALLEL_TRIANGLES, edge < 0.001, "{} triangles", model.triangles.len());
-        let settings = ContactSettings { self_collision: true, self_thickness: Some(0.002), ..Default::default() };
+        let settings = ContactSettings { self_collision: true, self_thickness: Some(0.002), relative_motion: relative, ..Default::default() };
         let contact = ContactModel::new(Vec::new(), settings).unwrap();
         let folded = |p: DVec2, drift: DVec3| {
             // The layers drift apart in opposite directions, as closing pairs would.
@@ -392,13 +413,15 @@ mod tests {
         let mut near = NearPairs::default();
         for step in 0..steps {
             let t = step as f64;
+            // Both layers also fall together, `fall` m a step.
             let drift = |t: f64| DVec3::new(0.0015 * t, 0.001 * (0.7 * t).sin(), -0.0001 * t);
-            let start: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, drift(t))).collect();
-            let predicted: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, drift(t + 1.0))).collect();
+            let folded = |p: DVec2, t: f64| folded(p, drift(t)) - DVec3::Z * (fall * t);
+            let start: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, t)).collect();
+            let predicted: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, t + 1.0)).collect();
             let contacts = contact.begin_step(model.cloth(), &mut near, &start, &predicted, 0.004);
             let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
             assert_eq!(listed.len(), contacts.pairs.len(), "step {step}: a pair listed twice");
-            assert_eq!(listed, all_pairs(&model, &start, &predicted, 0.002), "step {step}");
+            assert_eq!(listed, all_pairs(&model, &start, &predicted, 0.002, relative), "step {step}");
             total += listed.len();
         }
         total

@@ -24,7 +24,8 @@ impl Integrator {
             _ => (dt, s.x.clone(), (0..n).map(|i| s.x[i] + dt * s.v[i]).collect()),
         };
         let t_next = s.time + dt;
-        let step = ImplicitStep { model, h, anchor: &anchor, inertial: &inertial };
+        let start_velocity = s.v.clone();
+        let step = ImplicitStep { model, h, dt, anchor: &anchor, inertial: &inertial, velocity: &start_velocity };
         let prescribe = |mut y: Vec<DVec3>| {
             for (i, yi) in y.iter_mut().enumerate() {
                 if model.fixed[i] {
@@ -89,7 +90,6 @@ impl Integrator {
         for i in 0..n {
             s.v[i] = (y[i] - anchor[i]) / h;
         }
-        self.step_error = (0..n).filter(|&i| !model.fixed[i]).map(|i| 0.5 * dt * (s.v[i] - previous.1[i]).length()).fold(0.0, f64::max);
         if let Some(contacts) = &step_contacts {
             // A vertex whose rebound was absorbed gets a history of steady motion at its new
             // velocity, or BDF2's extrapolation from its falling past would lift it again.
@@ -117,11 +117,25 @@ impl Integrator {
 pub(super) struct ImplicitStep<'a> {
     pub model: &'a Model,
     pub h: f64,
+    /// The time step Δt, s (h is 2Δt/3 for BDF2).
+    pub dt: f64,
     pub anchor: &'a [DVec3],
     pub inertial: &'a [DVec3],
+    /// Velocities at the start of the step, m/s.
+    pub velocity: &'a [DVec3],
 }
 
 impl ImplicitStep<'_> {
+    /// Implicit Euler's local error estimate ½Δt·max|v_{n+1} − v_n| of the step were it to
+    /// end at `y` (v_{n+1} = (y − x̂)/h), m; over the free vertices.
+    pub fn local_error(&self, y: &[DVec3]) -> f64 {
+        let model = self.model;
+        (0..y.len())
+            .filter(|&i| !model.fixed[i])
+            .map(|i| 0.5 * self.dt * ((y[i] - self.anchor[i]) / self.h - self.velocity[i]).length())
+            .fold(0.0, f64::max)
+    }
+
     /// The incremental potential Φ at `y` without contact.
     pub fn potential(&self, y: &[DVec3]) -> f64 {
         let (model, h) = (self.model, self.h);

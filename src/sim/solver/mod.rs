@@ -24,7 +24,7 @@ mod report;
 mod settings;
 
 pub use report::{StepError, StepReport, StepTimings, UNCONVERGED_FACTOR};
-pub use settings::{AdaptiveStep, NewtonSettings, PreconditionerChoice};
+pub use settings::{AdaptiveStep, Indefinite, NewtonSettings, PreconditionerChoice};
 
 use crate::sim::contact::{ContactModel, ContactStats, NearPairs};
 use crate::sim::linalg::DirectPattern;
@@ -133,9 +133,6 @@ pub struct Integrator {
     shift: f64,
     /// The last shift that a failure had to be raised to: where the next failure starts.
     needed_shift: f64,
-    /// Implicit Euler's local error estimate of the last step, ½h·max|v_{n+1} − v_n| over
-    /// the free vertices, m (`NewtonSettings::error_share`).
-    step_error: f64,
 }
 
 impl Integrator {
@@ -153,7 +150,6 @@ impl Integrator {
             near_pairs: NearPairs::default(),
             shift: 0.0,
             needed_shift: 0.0,
-            step_error: 0.0,
         }
     }
 

@@ -6,6 +6,7 @@
 use super::implicit::ImplicitStep;
 use super::report::{StepReport, Stopwatch};
 use super::Integrator;
+use super::settings::Indefinite;
 use crate::sim::contact::StepContacts;
 use crate::sim::linalg::{BlockCsr, Coupling, ScalarCsr, SystemMatrix};
 use crate::sim::model::CompressedEdges;
@@ -29,16 +30,22 @@ pub(super) struct NewtonProblem<'a> {
     /// How much of that each free vertex's compressed edges may take back (the bounded
     /// matrix, `CompressedEdges::Within`); infinite on fixed vertices.
     pub softening: Vec<f64>,
-    /// Newton stops at a step shorter than this, m.
+    /// Newton stops at a step shorter than this, m: `base_tolerance`, or the step's own
+    /// integration error's share where that is more (updated at each iterate).
     pub tolerance: f64,
+    /// `NewtonSettings::tolerance` in metres.
+    base_tolerance: f64,
+    /// `NewtonSettings::error_share`.
+    error_share: f64,
     /// With nothing fixed and nothing touched, the elastic forces are internal: momentum is
     /// conserved, and each Newton direction is corrected to keep it so.
     pub all_free: bool,
 }
 
 impl<'a> NewtonProblem<'a> {
-    /// Newton's tolerance is `tolerance` mean edges, or `loose` metres where that is more.
-    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64, loose: f64) -> Self {
+    /// Newton's tolerance is `tolerance` mean edges, or `error_share` of the step's local
+    /// error where that is more.
+    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64, error_share: f64) -> Self {
         let ImplicitStep { model, h, .. } = *step;
         let zeta = model.options.damping;
         let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
@@ -47,7 +54,16 @@ impl<'a> NewtonProblem<'a> {
         // where the cloth buckles unless the compression outweighs inertia.
         let softening = mass_diagonal.iter().zip(&model.fixed).map(|(&d, &f)| if f { f64::INFINITY } else { SOFTENING_SHARE * d }).collect();
         let all_free = !model.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
-        Self { step, contacts, mass_diagonal, softening, tolerance: (tolerance * model.mean_edge_length).max(loose), all_free }
+        let base_tolerance = tolerance * model.mean_edge_length;
+        Self { step, contacts, mass_diagonal, softening, tolerance: base_tolerance, base_tolerance, error_share, all_free }
+    }
+
+    /// Sets the tolerance for an iterate `y`: a solve an order of magnitude more exact than
+    /// the step it serves (`NewtonSettings::error_share` of its local error, estimated at
+    /// `y`) adds nothing a user could see in a moving cloth, and at rest the base tolerance
+    /// holds.
+    fn update_tolerance(&mut self, y: &[DVec3]) {
+        self.tolerance = if self.error_share > 0.0 { self.base_tolerance.max(self.error_share * self.step.local_error(y)) } else { self.base_tolerance };
     }
 
     /// Φ at `y`, contact included.
@@ -108,7 +124,7 @@ impl Integrator {
     /// Newton's method on the incremental potential Φ (plus contact), from `y` in place.
     pub(super) fn newton(&mut self, step: &ImplicitStep, contacts: Option<&StepContacts>, y: &mut Vec<DVec3>, report: &mut StepReport) {
         let model = step.model;
-        let problem = NewtonProblem::new(step, contacts, self.newton.tolerance, self.newton.error_share * self.step_error);
+        let mut problem = NewtonProblem::new(step, contacts, self.newton.tolerance, self.newton.error_share);
         let n = y.len();
         let mut work = NewtonWork {
             stiffness: model.stiffness_matrix(),
@@ -119,10 +135,11 @@ impl Integrator {
             trial: y.clone(),
             couplings: Vec::new(),
         };
-        let mut history = NewtonHistory::default();
+        let mut history = NewtonHistory { bounded_throughout: self.newton.indefinite == Indefinite::Bound, ..NewtonHistory::default() };
         let mut watch = Stopwatch::start();
         report.newton_unconverged = true;
         for _ in 0..self.newton.max_iterations {
+            problem.update_tolerance(y);
             let norm = self.gradient(&problem, y, &mut work.gradient, &mut watch);
             work.rhs = work.gradient.iter().map(|g| -*g).collect();
             if let Some(length) = self.last_step_from_preconditioner(&problem, &history, norm, &mut work, y, &mut watch) {
@@ -150,7 +167,7 @@ impl Integrator {
 
     /// ∇Φ at `y` into `gradient` (zero on fixed vertices), and its norm.
     fn gradient(&mut self, problem: &NewtonProblem, y: &[DVec3], gradient: &mut [DVec3], watch: &mut Stopwatch) -> f64 {
-        let ImplicitStep { model, h, anchor, inertial } = *problem.step;
+        let ImplicitStep { model, h, anchor, inertial, .. } = *problem.step;
         let zeta = model.options.damping;
         let n = y.len();
         self.forces.resize(n, DVec3::ZERO);

@@ -36,6 +36,25 @@ pub struct NewtonSettings {
     pub warm_start: bool,
     /// The conjugate gradient's preconditioner.
     pub preconditioner: PreconditionerChoice,
+    /// How a global preconditioner's solve treats an indefinite Newton matrix (compressed
+    /// edges' softening outweighing inertia and bending).
+    pub indefinite: Indefinite,
+}
+
+/// How Newton's solves with a global preconditioner (the complete factor, multigrid) treat
+/// compressed edges' negative stiffness.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Indefinite {
+    /// The exact matrix, shifted by as small a share of the inertia as keeps it positive
+    /// definite: quadratic convergence where the cloth buckles, at the price of a new
+    /// factor whenever the shift must rise.
+    #[default]
+    Shift,
+    /// The softening bounded so that the matrix is positive definite by construction
+    /// (`CompressedEdges::Within`): no factor is rebuilt for a shift, Newton converges
+    /// linearly along buckling modes.
+    Bound,
 }
 
 /// Which factor preconditions the Newton systems' conjugate gradient.
@@ -86,7 +105,7 @@ impl PreconditionerChoice {
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { max_iterations: 30, tolerance: 1e-5, error_share: 0.0, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true, warm_start: false, preconditioner: PreconditionerChoice::Auto }
+        Self { max_iterations: 30, tolerance: 1e-5, error_share: 0.0, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true, warm_start: false, preconditioner: PreconditionerChoice::Auto, indefinite: Indefinite::Shift }
     }
 }
 
