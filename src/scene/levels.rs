@@ -109,11 +109,8 @@ fn coarsest_edge(config: &SceneConfig) -> Result<f64, crate::sim::FabricError> {
 /// Newton's iteration limit on the fast path's long steps.
 const FAST_MAX_ITERATIONS: usize = 80;
 
-/// Whether the scene loads its cloth slowly enough for the fast path's long steps: no
-/// props to land on, or props with gravity ramped up (a lowered specimen). A cloth dropped
-/// onto a prop keeps the scene's own step, because the penalty layer stops a vertex arriving
-/// at speed v within about v·Δt/√c (c the contact stiffness factor, 100), which longer steps
-/// would let exceed the contact thickness.
+/// Whether the scene loads its cloth slowly: no props to land on, or props with gravity
+/// ramped up (a lowered specimen). Otherwise the cloth is dropped onto its props.
 fn quasi_static(config: &SceneConfig) -> bool {
     config.props.is_empty() || config.scene.gravity_ramp.is_some()
 }
@@ -128,19 +125,28 @@ pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
         // Long steps follow a quasi-static load through near-equilibria, which holds where
         // the mesh resolves the folds. On a mesh whose elements are as wide as the folds the
         // drape depends on the path at the scale of an element, and the scene keeps its step.
+        // A cloth dropped onto a prop takes long steps on any mesh (its folds depend on the
+        // fall's path at every step), with the contact penalty's factor raised with the
+        // square of the step so that its stiffness c·m/Δt² stays the scene's: a vertex
+        // arriving at speed v then stops within v·Δt/√c of the same layer as at the scene's
+        // own step.
         let resolved = coarsest_edge(config).is_ok_and(|coarsest| edge <= coarsest * (1.0 + 1e-9));
-        if quasi_static(config) && resolved {
-            level.solver.dt = config.solver.dt.max(fast.dt);
+        let long = fast.dt > config.solver.dt && (resolved || !quasi_static(config));
+        if long {
+            level.solver.dt = fast.dt;
+            if !quasi_static(config) {
+                level.contact.stiffness *= (fast.dt / config.solver.dt).powi(2);
+            }
             // The first step after a transfer relaxes, in one long step, what the coarser
             // mesh could not resolve; Newton gets the iterations that takes.
             level.solver.newton.max_iterations = level.solver.newton.max_iterations.max(FAST_MAX_ITERATIONS);
+            // At long steps the incomplete factor leaves CG tens of iterations per Newton
+            // iteration even on coarse meshes; the complete factor a few.
+            if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
+                level.solver.newton.preconditioner = PreconditionerChoice::Cholesky;
+            }
         }
         level.solver.newton.error_share = fast.error_share;
-        // At the fast path's steps the incomplete factor leaves CG tens of iterations per
-        // Newton iteration even on coarse meshes; the complete factor a few.
-        if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
-            level.solver.newton.preconditioner = PreconditionerChoice::Cholesky;
-        }
     }
     level
 }

@@ -87,6 +87,7 @@ impl Integrator {
         }
         let mut previous = (s.x.clone(), s.v.clone());
         let start = s.x.clone();
+        self.last_step_error = step.local_error(&y);
         for i in 0..n {
             s.v[i] = (y[i] - anchor[i]) / h;
         }

@@ -133,6 +133,9 @@ pub struct Integrator {
     shift: f64,
     /// The last shift that a failure had to be raised to: where the next failure starts.
     needed_shift: f64,
+    /// The last step's local error estimate ½Δt·max|v_{n+1} − v_n|, m; infinite before the
+    /// first step (`NewtonSettings::error_share`).
+    last_step_error: f64,
 }
 
 impl Integrator {
@@ -150,6 +153,7 @@ impl Integrator {
             near_pairs: NearPairs::default(),
             shift: 0.0,
             needed_shift: 0.0,
+            last_step_error: f64::INFINITY,
         }
     }
 

@@ -37,6 +37,11 @@ pub(super) struct NewtonProblem<'a> {
     base_tolerance: f64,
     /// `NewtonSettings::error_share`.
     error_share: f64,
+    /// The local error the loosened tolerance may take at most: the previous step's, so that
+    /// an iterate whose own error estimate is inflated by its being wrong cannot loosen the
+    /// tolerance that accepts it (infinite on an integrator's first step, after a transfer
+    /// to a finer mesh).
+    error_cap: f64,
     /// With nothing fixed and nothing touched, the elastic forces are internal: momentum is
     /// conserved, and each Newton direction is corrected to keep it so.
     pub all_free: bool,
@@ -45,7 +50,7 @@ pub(super) struct NewtonProblem<'a> {
 impl<'a> NewtonProblem<'a> {
     /// Newton's tolerance is `tolerance` mean edges, or `error_share` of the step's local
     /// error where that is more.
-    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64, error_share: f64) -> Self {
+    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64, error_share: f64, error_cap: f64) -> Self {
         let ImplicitStep { model, h, .. } = *step;
         let zeta = model.options.damping;
         let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
@@ -55,15 +60,19 @@ impl<'a> NewtonProblem<'a> {
         let softening = mass_diagonal.iter().zip(&model.fixed).map(|(&d, &f)| if f { f64::INFINITY } else { SOFTENING_SHARE * d }).collect();
         let all_free = !model.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
         let base_tolerance = tolerance * model.mean_edge_length;
-        Self { step, contacts, mass_diagonal, softening, tolerance: base_tolerance, base_tolerance, error_share, all_free }
+        Self { step, contacts, mass_diagonal, softening, tolerance: base_tolerance, base_tolerance, error_share, error_cap, all_free }
     }
 
     /// Sets the tolerance for an iterate `y`: a solve an order of magnitude more exact than
     /// the step it serves (`NewtonSettings::error_share` of its local error, estimated at
-    /// `y`) adds nothing a user could see in a moving cloth, and at rest the base tolerance
-    /// holds.
+    /// `y` and at most the previous step's) adds nothing a user could see in a moving cloth,
+    /// and at rest the base tolerance holds.
     fn update_tolerance(&mut self, y: &[DVec3]) {
-        self.tolerance = if self.error_share > 0.0 { self.base_tolerance.max(self.error_share * self.step.local_error(y)) } else { self.base_tolerance };
+        self.tolerance = if self.error_share > 0.0 {
+            self.base_tolerance.max(self.error_share * self.step.local_error(y).min(self.error_cap))
+        } else {
+            self.base_tolerance
+        };
     }
 
     /// Φ at `y`, contact included.
@@ -124,7 +133,7 @@ impl Integrator {
     /// Newton's method on the incremental potential Φ (plus contact), from `y` in place.
     pub(super) fn newton(&mut self, step: &ImplicitStep, contacts: Option<&StepContacts>, y: &mut Vec<DVec3>, report: &mut StepReport) {
         let model = step.model;
-        let mut problem = NewtonProblem::new(step, contacts, self.newton.tolerance, self.newton.error_share);
+        let mut problem = NewtonProblem::new(step, contacts, self.newton.tolerance, self.newton.error_share, self.last_step_error);
         let n = y.len();
         let mut work = NewtonWork {
             stiffness: model.stiffness_matrix(),
