@@ -10,6 +10,7 @@
 //! scenes.
 pub mod app;
 pub mod bench;
+pub mod card;
 pub mod chart;
 pub mod fabric;
 pub mod lab;
