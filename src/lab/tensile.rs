@@ -99,8 +99,8 @@ pub struct TensilePull {
     pub direction: Direction,
     /// The strain the clamp pulled to (by the clamps' separation), a fraction.
     pub max_strain: f64,
-    /// (extensometer strain, stress N/m), a few dozen points evenly spaced in time
-    /// (`TensileMeasures::stress_strain`).
+    /// (extensometer strain, stress N/m) from the unloaded start, then the rig's few dozen
+    /// points evenly spaced in time (`TensileMeasures::stress_strain`).
     pub curve: Vec<[f64; 2]>,
     /// −lateral strain over extensometer strain at the end of the pull.
     pub poisson_ratio: f64,
@@ -123,5 +123,7 @@ pub fn tensile_pull(fabric: &FabricConfig, direction: Direction, max_strain: f64
     })?;
     let m = super::run(TEST, config)?;
     let t = m.measures.tensile().ok_or_else(|| LabError::NoReading { test: TEST, message: "the rig reported no tensile measures".into() })?;
-    Ok(TensilePull { direction, max_strain, curve: t.stress_strain.clone(), poisson_ratio: t.poisson_ratio })
+    // The rig samples after its steps; the strip starts unloaded and unstretched.
+    let curve = std::iter::once([0.0, 0.0]).chain(t.stress_strain.iter().copied().filter(|p| p[0] > 0.0)).collect();
+    Ok(TensilePull { direction, max_strain, curve, poisson_ratio: t.poisson_ratio })
 }
