@@ -212,8 +212,9 @@ impl CardView {
             }
             ui.label("shear G");
             ui.monospace(format!("{:.2} N/m", c.shear.modulus_n_per_m));
+            // Wall time: the process's CPU time here includes the window and the solver.
             ui.label("made in");
-            ui.monospace(format!("{:.1} CPU s", c.cost.cpu_seconds));
+            ui.monospace(format!("{:.1} s", c.cost.wall_seconds));
             ui.end_row();
         });
         if ui.button("Save card (PNG and JSON)").on_hover_text("rosette-card-NAME.png and .json in the working directory").clicked() {

@@ -288,7 +288,7 @@ impl ViewerUi {
         ui.separator();
         self.solver_panel(ui, snapshot, actions);
         ui.separator();
-        self.fabric_panel(ui);
+        self.fabric_panel(ui, &snapshot.scene_name);
     }
 
     fn solver_panel(&mut self, ui: &mut egui::Ui, snapshot: &Snapshot, actions: &mut Vec<Action>) {
@@ -314,7 +314,7 @@ impl ViewerUi {
         }
     }
 
-    fn fabric_panel(&mut self, ui: &mut egui::Ui) {
+    fn fabric_panel(&mut self, ui: &mut egui::Ui, scene: &str) {
         ui.heading("Fabric");
         let Some(fabric) = &mut self.fabric else { return };
         let mut changed = false;
@@ -326,7 +326,12 @@ impl ViewerUi {
                         match crate::fabric::parse_fabric(bundled.text, bundled.name).map(|loaded| loaded.config) {
                             Ok(mut f) => {
                                 f.preset = Some(bundled.name.to_string());
-                                *fabric = f;
+                                // As the scene runs it (`--set fabric.preset=NAME`): a drape
+                                // scene's own fabric keys stay.
+                                match crate::card::scene_fabric(scene, &f) {
+                                    Ok(f) => *fabric = f,
+                                    Err(e) => self.messages.push(format!("fabric {}: {e}", bundled.name)),
+                                }
                                 changed = true;
                             }
                             Err(e) => self.messages.push(format!("fabric {}: {e}", bundled.name)),

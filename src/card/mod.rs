@@ -17,7 +17,7 @@ pub mod page;
 pub mod picture;
 mod suite;
 
-pub use suite::{CardRun, compute, drape_config};
+pub use suite::{CardRun, compute, drape_config, scene_fabric};
 
 use crate::lab::LabError;
 use serde::{Deserialize, Serialize};

@@ -63,24 +63,30 @@ enum Outcome {
     Shear(ShearTest),
 }
 
-/// A drape scene with `fabric` in it: the scene's own `[fabric]` keys other than the
-/// fabric's name (the cusick scenes turn the Poisson coupling off, docs/drape.md) laid over
-/// the fabric, as `rosette run SCENE --set fabric.preset=FABRIC` lays them over a fabric
-/// file. `scene` is a bundled scene's name.
-pub fn drape_config(scene: &str, fabric: &FabricConfig) -> Result<SceneConfig, CardError> {
+/// `fabric` as the bundled scene `scene` runs it: the scene's own `[fabric]` keys other than
+/// the fabric's name laid over it (the drape scenes turn the Poisson coupling off,
+/// docs/drape.md), as `rosette run SCENE --set fabric.preset=FABRIC` lays them over a fabric
+/// file. A scene that is not bundled leaves the fabric as it is.
+pub fn scene_fabric(scene: &str, fabric: &FabricConfig) -> Result<FabricConfig, CardError> {
     let bad = |m: String| CardError::BadInput(m);
-    let bundled = SCENES.iter().find(|s| s.name == scene).ok_or_else(|| bad(format!("no bundled scene named '{scene}'")))?;
-    let (mut config, _) = load_scene(scene, &[]).map_err(|e| bad(e.to_string()))?;
+    let Some(bundled) = SCENES.iter().find(|s| s.name == scene) else { return Ok(fabric.clone()) };
     let text: toml::Table = bundled.text.parse().map_err(|e| bad(format!("{scene}: {e}")))?;
+    let Some(keys) = text.get("fabric").and_then(|v| v.as_table()) else { return Ok(fabric.clone()) };
     let mut table = toml::Table::try_from(fabric).map_err(|e| bad(format!("fabric: {e}")))?;
-    if let Some(keys) = text.get("fabric").and_then(|v| v.as_table()) {
-        for (key, value) in keys.iter().filter(|(k, _)| !matches!(k.as_str(), "preset" | "name" | "description")) {
-            table.insert(key.clone(), value.clone());
-        }
+    for (key, value) in keys.iter().filter(|(k, _)| !matches!(k.as_str(), "preset" | "name" | "description")) {
+        table.insert(key.clone(), value.clone());
     }
-    let merged: FabricConfig = toml::Value::Table(table).try_into().map_err(|e: toml::de::Error| bad(format!("fabric: {}", e.message())))?;
-    config.fabric = merged;
-    config.material().map_err(|e| bad(format!("{scene} with this fabric: {e}")))?;
+    toml::Value::Table(table).try_into().map_err(|e: toml::de::Error| bad(format!("fabric: {}", e.message())))
+}
+
+/// The bundled drape scene `scene` with `fabric` in it ([`scene_fabric`]).
+pub fn drape_config(scene: &str, fabric: &FabricConfig) -> Result<SceneConfig, CardError> {
+    if !SCENES.iter().any(|s| s.name == scene) {
+        return Err(CardError::BadInput(format!("no bundled scene named '{scene}'")));
+    }
+    let (mut config, _) = load_scene(scene, &[]).map_err(|e| CardError::BadInput(e.to_string()))?;
+    config.fabric = scene_fabric(scene, fabric)?;
+    config.material().map_err(|e| CardError::BadInput(format!("{scene} with this fabric: {e}")))?;
     Ok(config)
 }
 
