@@ -144,7 +144,7 @@ impl CardView {
         ui.small(
             "The virtual laboratory on the fabric being edited: KES tensile (warp, weft) and a bias pull, pure bending and \
              the ASTM D1388 cantilever (warp, weft, bias), KES shear and the 30 cm Cusick drape, as `rosette card` makes it. \
-             About 10–20 CPU seconds, on threads of its own.",
+             About 10 to 30 CPU seconds, on threads of its own.",
         );
         match (&self.making, fabric) {
             (None, Some(fabric)) => {
