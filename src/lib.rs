@@ -10,7 +10,9 @@
 //! scenes.
 pub mod app;
 pub mod bench;
+pub mod card;
 pub mod chart;
+pub mod export;
 pub mod fabric;
 pub mod lab;
 pub mod reference;

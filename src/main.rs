@@ -8,6 +8,9 @@ use rosette::scene::{RunOptions, Scene, StepRecord, load_scene, preset, run_scen
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
+/// `rosette card` and `rosette compare`.
+mod cli;
+
 #[derive(Parser)]
 #[command(
     name = "rosette",
@@ -60,6 +63,14 @@ enum Command {
         /// with longer steps and Newton solved to the step's own accuracy (docs/solvers.md).
         #[arg(long)]
         fast: bool,
+        /// Write the cloth as glTF 2.0 binary (Blender, three.js): the final state, or with
+        /// --export-frames an animation of the run.
+        #[arg(long, value_name = "FILE.glb")]
+        export: Option<std::path::PathBuf>,
+        /// With --export: N frames spread evenly over the run (2 to 1000), played back at
+        /// the simulated times.
+        #[arg(long, value_name = "N", requires = "export")]
+        export_frames: Option<usize>,
         #[command(flatten)]
         screenshot: ScreenshotArgs,
     },
@@ -72,6 +83,32 @@ enum Command {
         /// The small sweep the tests run: fewer and smaller runs, no drape.
         #[arg(long)]
         quick: bool,
+    },
+    /// The fabric card: the virtual laboratory's tests and the 30 cm Cusick drape on one
+    /// fabric, written as DIR/NAME.png (one page) and DIR/NAME.json.
+    Card {
+        /// A bundled fabric's name (see `rosette fabric list`) or a fabric file.
+        fabric: String,
+        /// Directory for the page and the JSON (created if missing).
+        #[arg(long, value_name = "DIR", default_value = ".")]
+        out: std::path::PathBuf,
+    },
+    /// Drape several fabrics on one scene in parallel and set them side by side: a contact
+    /// sheet PNG (same camera for all, DC and nodes under each) with its numbers as JSON and
+    /// CSV beside it.
+    Compare {
+        /// Bundled fabric names or fabric files.
+        #[arg(required = true, num_args = 1..)]
+        fabrics: Vec<String>,
+        /// The drape scene to run them on.
+        #[arg(long, default_value = "cusick-drape-30")]
+        scene: String,
+        /// Override a scene value for every fabric, e.g. --set scene.duration=3 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<String>,
+        /// The contact sheet; FILE.json and FILE.csv are written beside it.
+        #[arg(long, value_name = "FILE.png", default_value = "compare.png")]
+        out: std::path::PathBuf,
     },
     /// List the bundled scenes.
     Presets,
@@ -216,12 +253,20 @@ fn main() -> ExitCode {
             }
         },
         Some(Command::Chart { out, quick }) => chart(out, quick),
+        Some(Command::Card { fabric, out }) => cli::card(&fabric, &out),
+        Some(Command::Compare { fabrics, scene, overrides, out }) => cli::compare(&fabrics, &scene, &overrides, &out),
         Some(Command::Fabric { action }) => fabric(action),
-        Some(Command::Run { preset, mut overrides, duration, metrics, outline, step_log, max_steps, max_wall, fast, screenshot }) => {
+        Some(Command::Run { preset, mut overrides, duration, metrics, outline, step_log, max_steps, max_wall, fast, export, export_frames, screenshot }) => {
             if fast {
                 overrides.push(FAST_PATH.to_string());
             }
-            let outputs = RunOutputs { metrics: metrics.as_deref(), outline: outline.as_deref(), step_log: step_log.as_deref() };
+            let outputs = RunOutputs {
+                metrics: metrics.as_deref(),
+                outline: outline.as_deref(),
+                step_log: step_log.as_deref(),
+                export: export.as_deref(),
+                export_frames,
+            };
             run(&preset, &overrides, &RunLimits { duration, max_steps, max_wall }, &outputs, &screenshot)
         }
     }
@@ -350,7 +395,15 @@ struct RunOutputs<'a> {
     metrics: Option<&'a str>,
     outline: Option<&'a str>,
     step_log: Option<&'a std::path::Path>,
+    /// The glTF file, and how many frames of the run it animates (the final state alone
+    /// when `None`).
+    export: Option<&'a std::path::Path>,
+    export_frames: Option<usize>,
 }
+
+/// Most frames an animated export may hold: each is a morph target, and the animation's
+/// weights grow as the square of their number.
+const MAX_EXPORT_FRAMES: usize = 1000;
 
 /// How long `rosette run` may go on.
 struct RunLimits {
@@ -400,7 +453,12 @@ fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutput
     if outline_out.is_some() && config.scene.kind != rosette::scene::SceneKind::Drape {
         return bad_input(format!("--outline: {spec} is not a drape scene; only drape scenes have a shadow outline"));
     }
-    let paths = [("--metrics", metrics_out.filter(|m| *m != "-").map(std::path::Path::new)), ("--outline", outline_out.map(std::path::Path::new)), ("--screenshot", shot.screenshot.as_deref())];
+    let paths = [
+        ("--metrics", metrics_out.filter(|m| *m != "-").map(std::path::Path::new)),
+        ("--outline", outline_out.map(std::path::Path::new)),
+        ("--screenshot", shot.screenshot.as_deref()),
+        ("--export", outputs.export),
+    ];
     for (option, path) in paths {
         if let Some(Err(e)) = path.map(|p| check_writable(option, p)) {
             return bad_input(format!("{e:#}"));
@@ -408,6 +466,12 @@ fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutput
     }
     if let Some(path) = shot.screenshot.as_deref().filter(|p| !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))) {
         return bad_input(format!("--screenshot {}: the picture is written as PNG; name the file FILE.png", path.display()));
+    }
+    if let Some(path) = outputs.export.filter(|p| !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"))) {
+        return bad_input(format!("--export {}: the cloth is written as glTF binary; name the file FILE.glb", path.display()));
+    }
+    if let Some(n) = outputs.export_frames.filter(|n| !(2..=MAX_EXPORT_FRAMES).contains(n)) {
+        return bad_input(format!("--export-frames {n}: an animation needs 2 to {MAX_EXPORT_FRAMES} frames (leave it out for the final state alone)"));
     }
     // The step log is opened before the run, so that a bad path fails at once, and
     // written as the run goes, so that a run stopped early keeps its rows.
@@ -447,12 +511,23 @@ fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutput
             log_error = writeln!(out, "{}", record.csv_row()).err();
         }
     };
+    let mut recorder = outputs.export_frames.map(|n| {
+        let mut r = rosette::export::Recorder::new(n, scene.state.time, limits.duration.unwrap_or(scene.config.scene.duration));
+        r.observe(scene.state.time, &scene.state.x);
+        r
+    });
+    let mut on_state = |s: &Scene| {
+        if let Some(r) = recorder.as_mut() {
+            r.observe(s.state.time, &s.state.x);
+        }
+    };
     let options = RunOptions {
         duration: limits.duration,
         progress: Some(&mut on_progress),
         on_step: Some(&mut on_step),
         max_steps: None,
         max_wall_seconds: Some(limits.max_wall),
+        on_state: Some(&mut on_state),
     };
     let (metrics, error) = run_scene(&mut scene, &name, options);
     if let Some(bar) = &bar {
@@ -482,6 +557,18 @@ fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutput
             metrics.steps, metrics.dt, metrics.integrator, metrics.simulated_seconds, metrics.wall_seconds, metrics.cpu_seconds_per_10ms
         );
         println!("{}", serde_json::to_string_pretty(&metrics.measures).expect("JSON values serialise"));
+    }
+    if let Some(path) = outputs.export {
+        // The last good state (and the run up to it), also after a divergence.
+        let frames = match recorder {
+            Some(r) => r.finish(scene.state.time, &scene.state.x),
+            None => vec![(scene.state.time, scene.state.x.clone())],
+        };
+        let cloth = rosette::export::Cloth { triangles: &scene.model.triangles, rest: &scene.model.rest, warp_angle: scene.model.warp_angle, name: &name };
+        match rosette::export::write_glb(path, &cloth, &frames) {
+            Ok(()) => eprintln!("wrote {} ({} frame{})", path.display(), frames.len(), if frames.len() == 1 { "" } else { "s" }),
+            Err(e) => fail(anyhow::anyhow!("--export: {e}")),
+        }
     }
     if let Some(path) = &shot.screenshot {
         // The last good state, also after a divergence.

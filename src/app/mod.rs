@@ -5,11 +5,15 @@
 //! - [`ui`]: the egui panels and the view's mouse and keys, turned into actions.
 //! - [`camera`]: orbit camera and ray picking; [`colour`]: strain/bending colour maps;
 //!   [`plots`]: live test plots and their references; [`files`]: TOML, OBJ, CSV;
-//!   [`chart_view`]: the speed/accuracy charts of `rosette chart`.
+//!   [`chart_view`]: the speed/accuracy charts of `rosette chart`; [`card_view`]: the
+//!   fabric card of the fabric being edited; [`pin`]: a fabric's result kept beside the live
+//!   one.
 pub mod camera;
+pub mod card_view;
 pub mod chart_view;
 pub mod colour;
 pub mod files;
+pub mod pin;
 pub mod plots;
 pub mod ui;
 pub mod worker;

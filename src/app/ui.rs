@@ -4,7 +4,9 @@
 //! `egui::Context`.
 
 use super::camera::OrbitCamera;
+use super::card_view::CardView;
 use super::chart_view::ChartView;
+use super::pin::Pinned;
 use super::colour::ColourMap;
 use super::plots::{self, History};
 use super::worker::{Command, Snapshot};
@@ -35,7 +37,11 @@ pub enum Action {
     SaveFabric,
     ExportObj,
     ExportCsv,
+    /// The cloth as it is now, as glTF binary (`crate::export`).
+    ExportGltf,
     Screenshot,
+    /// Keep the current fabric's picture and measures beside the live view.
+    Pin,
 }
 
 /// A cloth point held by the mouse: it moves in the plane through the picked point facing
@@ -76,6 +82,10 @@ pub struct ViewerUi {
     mouse_drag: Option<MouseDrag>,
     /// The speed/accuracy chart window (`rosette chart`'s tables).
     pub chart: ChartView,
+    /// The Fabric card window.
+    pub card: CardView,
+    /// A fabric's result kept for comparison, shown at the top of the right panel.
+    pub pinned: Option<Pinned>,
 }
 
 impl Default for ViewerUi {
@@ -98,6 +108,8 @@ impl Default for ViewerUi {
             history_kind: None,
             mouse_drag: None,
             chart: ChartView::default(),
+            card: CardView::default(),
+            pinned: None,
         }
     }
 }
@@ -118,6 +130,7 @@ impl ViewerUi {
         });
         egui::CentralPanel::no_frame().show(ui, |ui| self.view(ui, snapshot, &mut actions));
         self.chart.show(ui.ctx());
+        self.card.show(ui.ctx(), self.fabric.as_ref());
         self.flush_fabric(&mut actions);
         actions
     }
@@ -167,6 +180,7 @@ impl ViewerUi {
                     ("Open fabric…", Action::OpenFabric),
                     ("Save fabric…", Action::SaveFabric),
                     ("Export cloth mesh (OBJ)…", Action::ExportObj),
+                    ("Export glTF (GLB, Blender, web)…", Action::ExportGltf),
                     ("Export test data (CSV)…", Action::ExportCsv),
                     ("Save screenshot (PNG)  F12", Action::Screenshot),
                 ] {
@@ -224,6 +238,15 @@ impl ViewerUi {
             }
             ui.separator();
             ui.toggle_value(&mut self.chart.open, "Chart").on_hover_text("speed against accuracy: the tables of `rosette chart`");
+            ui.toggle_value(&mut self.card.open, "Fabric card")
+                .on_hover_text("the virtual laboratory's tests and the 30 cm drape on the fabric being edited (`rosette card`)");
+            if ui
+                .button(if self.pinned.is_some() { "Pin again" } else { "Pin fabric" })
+                .on_hover_text("keep this fabric's picture and measures beside the live view, to compare while you edit")
+                .clicked()
+            {
+                actions.push(Action::Pin);
+            }
         });
         if let Some(error) = &snapshot.error {
             ui.colored_label(Color32::from_rgb(255, 110, 100), format!("Error: {error}"));
@@ -266,7 +289,7 @@ impl ViewerUi {
         ui.separator();
         self.solver_panel(ui, snapshot, actions);
         ui.separator();
-        self.fabric_panel(ui);
+        self.fabric_panel(ui, &snapshot.scene_name);
     }
 
     fn solver_panel(&mut self, ui: &mut egui::Ui, snapshot: &Snapshot, actions: &mut Vec<Action>) {
@@ -309,7 +332,7 @@ impl ViewerUi {
         }
     }
 
-    fn fabric_panel(&mut self, ui: &mut egui::Ui) {
+    fn fabric_panel(&mut self, ui: &mut egui::Ui, scene: &str) {
         ui.heading("Fabric");
         let Some(fabric) = &mut self.fabric else { return };
         let mut changed = false;
@@ -321,7 +344,12 @@ impl ViewerUi {
                         match crate::fabric::parse_fabric(bundled.text, bundled.name).map(|loaded| loaded.config) {
                             Ok(mut f) => {
                                 f.preset = Some(bundled.name.to_string());
-                                *fabric = f;
+                                // As the scene runs it (`--set fabric.preset=NAME`): a drape
+                                // scene's own fabric keys stay.
+                                match crate::card::scene_fabric(scene, &f) {
+                                    Ok(f) => *fabric = f,
+                                    Err(e) => self.messages.push(format!("fabric {}: {e}", bundled.name)),
+                                }
                                 changed = true;
                             }
                             Err(e) => self.messages.push(format!("fabric {}: {e}", bundled.name)),
@@ -397,6 +425,12 @@ impl ViewerUi {
     }
 
     fn right_panel(&mut self, ui: &mut egui::Ui, snapshot: &Snapshot, actions: &mut Vec<Action>) {
+        if let Some(pinned) = &mut self.pinned {
+            if pinned.show(ui, snapshot) {
+                self.pinned = None;
+            }
+            ui.separator();
+        }
         ui.heading("Fabric tests");
         ui.small("Each runs the bundled laboratory scene on the fabric being edited.");
         ui.horizontal_wrapped(|ui| {

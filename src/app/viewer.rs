@@ -110,6 +110,7 @@ enum DialogKind {
     SaveFabric,
     ExportObj,
     ExportCsv,
+    ExportGltf,
 }
 
 /// GPU state that exists while the window does.
@@ -325,14 +326,35 @@ impl App {
                 }
                 return;
             }
+            Action::Pin => {
+                self.pin(snapshot);
+                return;
+            }
             Action::OpenScene => DialogKind::OpenScene,
             Action::SaveScene => DialogKind::SaveScene,
             Action::OpenFabric => DialogKind::OpenFabric,
             Action::SaveFabric => DialogKind::SaveFabric,
             Action::ExportObj => DialogKind::ExportObj,
             Action::ExportCsv => DialogKind::ExportCsv,
+            Action::ExportGltf => DialogKind::ExportGltf,
         };
         self.open_dialog(dialog, &snapshot.scene_name);
+    }
+
+    /// Pins the current fabric: the view as drawn now (at most 480 pixels wide) and the
+    /// measures, shown beside the live view from the next frame.
+    fn pin(&mut self, snapshot: &Snapshot) {
+        let Some(gpu) = &mut self.gpu else { return };
+        let rect = self.ui.view_rect;
+        let scale = (480.0 / rect.width().max(1.0)).min(1.0);
+        let size = [((rect.width() * scale) as u32).max(16), ((rect.height() * scale) as u32).max(16)];
+        match render_view(gpu, snapshot, &self.ui, size) {
+            Ok(picture) => {
+                self.ui.pinned = Some(super::pin::Pinned::new(snapshot, picture));
+                gpu.window.request_redraw();
+            }
+            Err(e) => self.ui.messages.push(format!("cannot pin: {e:#}")),
+        }
     }
 
     /// Opens a file dialog on its own thread, so the window keeps drawing while it is open.
@@ -349,6 +371,7 @@ impl App {
                 DialogKind::OpenFabric | DialogKind::SaveFabric => ("fabric", "toml"),
                 DialogKind::ExportObj => ("Wavefront OBJ", "obj"),
                 DialogKind::ExportCsv => ("CSV", "csv"),
+                DialogKind::ExportGltf => ("glTF binary", "glb"),
             };
             let dialog = rfd::FileDialog::new().add_filter(filter, &[extension]);
             let path = match kind {
@@ -392,6 +415,15 @@ impl App {
             DialogKind::SaveFabric => write(files::fabric_toml(&snapshot.config.fabric)?)?,
             DialogKind::ExportObj => write(files::mesh_obj(&snapshot.positions, &snapshot.rest, &snapshot.triangles))?,
             DialogKind::ExportCsv => write(files::measures_csv(&snapshot.measures, &self.ui.history.names, &self.ui.history.rows))?,
+            DialogKind::ExportGltf => {
+                let cloth = crate::export::Cloth {
+                    triangles: &snapshot.triangles,
+                    rest: &snapshot.rest,
+                    warp_angle: snapshot.config.cloth.warp_angle_deg.to_radians(),
+                    name: &snapshot.scene_name,
+                };
+                crate::export::write_glb(path, &cloth, &[(snapshot.time, snapshot.positions.clone())]).map_err(|e| e.to_string())?;
+            }
         }
         self.ui.notice = Some(format!("saved {}", path.display()));
         Ok(())
@@ -472,16 +504,7 @@ fn draw_scene(
     let options = RenderOptions { wireframe: ui.wireframe, ..RenderOptions::default() };
     let draw = view_w > 0 && view_h > 0 && !snapshot.positions.is_empty();
     if draw {
-        let mut frame = Frame::from_cloth(&snapshot.positions, &snapshot.triangles, &snapshot.rest, snapshot.config.cloth.warp_angle_deg.to_radians());
-        if let (Some(map), Some(field)) = (render_map(ui.colour_map), colour::field(snapshot, ui.colour_map)) {
-            frame.cloth_scalar = Some(ScalarField { map, values: field.values, min: field.min, max: field.max });
-        }
-        frame.props = snapshot
-            .props
-            .iter()
-            .map(|(p, t)| PropMesh { positions: p.iter().map(|v| v.as_vec3().to_array()).collect(), triangles: t.clone() })
-            .collect();
-        frame.floor_z = snapshot.ground_z.map(|z| z as f32).or_else(|| frame.floor_below());
+        let frame = snapshot_frame(snapshot, ui);
         gpu.scene_renderer.prepare(&gpu.device, &gpu.queue, &frame, &ui.camera.view(), &options, [view_w, view_h]);
     }
     let [r, g, b] = options.background.map(f64::from);
@@ -506,6 +529,44 @@ fn draw_scene(
         pass.set_viewport(x0, y0, view_w as f32, view_h as f32, 0.0, 1.0);
         gpu.scene_renderer.paint(&mut pass);
     }
+}
+
+/// What the view draws of `snapshot`: the cloth in the chosen colour map, the props and the
+/// floor.
+fn snapshot_frame(snapshot: &Snapshot, ui: &ViewerUi) -> Frame {
+    let mut frame = Frame::from_cloth(&snapshot.positions, &snapshot.triangles, &snapshot.rest, snapshot.config.cloth.warp_angle_deg.to_radians());
+    if let (Some(map), Some(field)) = (render_map(ui.colour_map), colour::field(snapshot, ui.colour_map)) {
+        frame.cloth_scalar = Some(ScalarField { map, values: field.values, min: field.min, max: field.max });
+    }
+    frame.props = snapshot
+        .props
+        .iter()
+        .map(|(p, t)| PropMesh { positions: p.iter().map(|v| v.as_vec3().to_array()).collect(), triangles: t.clone() })
+        .collect();
+    frame.floor_z = snapshot.ground_z.map(|z| z as f32).or_else(|| frame.floor_below());
+    frame
+}
+
+/// The 3D view alone (no panels), as the window's camera sees it, rendered offscreen at
+/// `size` pixels and read back.
+fn render_view(gpu: &mut Gpu, snapshot: &Snapshot, ui: &ViewerUi, size: [u32; 2]) -> anyhow::Result<image::RgbaImage> {
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("pinned view"),
+        size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: gpu.config.format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+    let options = RenderOptions { wireframe: ui.wireframe, ..RenderOptions::default() };
+    gpu.scene_renderer.prepare(&gpu.device, &gpu.queue, &snapshot_frame(snapshot, ui), &ui.camera.view(), &options, size);
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pinned view") });
+    gpu.scene_renderer.render(&mut encoder, &view);
+    gpu.queue.submit([encoder.finish()]);
+    Ok(render::read_back(&gpu.device, &gpu.queue, &texture)?)
 }
 
 /// Renders the frame again into an offscreen texture, reads it back and writes a PNG.

@@ -15,7 +15,7 @@ use std::sync::Once;
 /// Size of one chart panel, pixels.
 pub const PANEL: (u32, u32) = (560, 420);
 
-fn register_font() {
+pub(crate) fn register_font() {
     static FONT: Once = Once::new();
     FONT.call_once(|| {
         // The bundled font is a valid TTF; failing that, text would be missing, not wrong.

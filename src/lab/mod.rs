@@ -6,6 +6,8 @@
 //! - [`shear`]: the mean slope of shear force against angle from 0.5° to 5°, G (KES-FB1).
 //! - [`cantilever_bending_length`]: half the overhang at which a 25 mm strip's tip meets
 //!   the 41.5° plane (ASTM D1388, BS 3356).
+//! - [`tensile_pull`]: a strip pulled to a strain, its stress–strain curve (the fabric
+//!   card's bias pull).
 //!
 //! Definitions and units: docs/references.md §8. Each test builds on a bundled scene
 //! (tensile-warp, arc, shear-buckling, cantilever), takes the fabric as given and reports
@@ -21,9 +23,9 @@ mod tensile;
 
 pub use bending::{PureBending, pure_bending};
 pub use cantilever::{CantileverTest, cantilever_bending_length};
-pub use readback::{Property, ReadBack, readback};
+pub use readback::{LabRuns, Property, ReadBack, readback, readback_with};
 pub use shear::{ShearTest, shear};
-pub use tensile::{KesTensile, kes_tensile};
+pub use tensile::{KesTensile, TensilePull, kes_tensile, tensile_pull};
 
 use crate::scene::preset::FabricConfig;
 use crate::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};

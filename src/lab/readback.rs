@@ -1,7 +1,7 @@
 //! The round trip: run the virtual tests on a fabric imported from a sheet and set what
 //! they read beside what the sheet says.
 
-use super::{Direction, KesTensile, LabError, PureBending, ShearTest, cantilever_bending_length, kes_tensile, pure_bending, shear};
+use super::{CantileverTest, Direction, KesTensile, LabError, PureBending, ShearTest, cantilever_bending_length, kes_tensile, pure_bending, shear};
 use crate::fabric::bias::STANDARD_STRIP_WIDTH;
 use crate::fabric::import::{FAST_SHEAR_CONSTANT, Import, KES_FM};
 use crate::fabric::sheet::{SheetKind, Sheets};
@@ -70,34 +70,54 @@ impl ReadBack {
     }
 }
 
+/// Virtual tests already run on the fabric, handed to [`readback_with`] so that it reads
+/// them instead of running them again (the fabric card runs them all in parallel first).
+/// They must have been run on the same fabric.
+#[derive(Debug, Clone, Default)]
+pub struct LabRuns {
+    pub tensile: BTreeMap<Direction, KesTensile>,
+    pub bending: BTreeMap<Direction, PureBending>,
+    pub shear: Option<ShearTest>,
+    pub cantilever: Vec<CantileverTest>,
+}
+
 /// The virtual tests' results, each run once whatever asks for it.
 struct Runs<'a> {
     fabric: &'a FabricConfig,
-    tensile: BTreeMap<Direction, KesTensile>,
-    bending: BTreeMap<Direction, PureBending>,
-    shear: Option<ShearTest>,
+    done: LabRuns,
 }
 
 impl Runs<'_> {
     fn tensile(&mut self, d: Direction) -> Result<&KesTensile, LabError> {
-        if !self.tensile.contains_key(&d) {
-            self.tensile.insert(d, kes_tensile(self.fabric, d)?);
+        if !self.done.tensile.contains_key(&d) {
+            self.done.tensile.insert(d, kes_tensile(self.fabric, d)?);
         }
-        Ok(&self.tensile[&d])
+        Ok(&self.done.tensile[&d])
     }
 
     fn bending(&mut self, d: Direction) -> Result<&PureBending, LabError> {
-        if !self.bending.contains_key(&d) {
-            self.bending.insert(d, pure_bending(self.fabric, d)?);
+        if !self.done.bending.contains_key(&d) {
+            self.done.bending.insert(d, pure_bending(self.fabric, d)?);
         }
-        Ok(&self.bending[&d])
+        Ok(&self.done.bending[&d])
     }
 
     fn shear(&mut self) -> Result<&ShearTest, LabError> {
-        if self.shear.is_none() {
-            self.shear = Some(shear(self.fabric)?);
+        if self.done.shear.is_none() {
+            self.done.shear = Some(shear(self.fabric)?);
         }
-        Ok(self.shear.as_ref().expect("just run"))
+        Ok(self.done.shear.as_ref().expect("just run"))
+    }
+
+    /// The bending length of a strip `width` wide cut along `d`.
+    fn cantilever(&mut self, d: Direction, width: f64) -> Result<f64, LabError> {
+        if let Some(t) = self.done.cantilever.iter().find(|t| t.direction == d && t.strip_width == width) {
+            return Ok(t.bending_length);
+        }
+        let t = cantilever_bending_length(self.fabric, d, width)?;
+        let c = t.bending_length;
+        self.done.cantilever.push(t);
+        Ok(c)
     }
 }
 
@@ -109,7 +129,12 @@ fn supplier(import: &Import, key: &str) -> Option<SheetKind> {
 /// Runs the virtual tests that check each value the fabric took from its sheets, on the
 /// fabric as loaded (`fabric`), and returns the table of sheet against reading.
 pub fn readback(sheets: &Sheets, import: &Import, fabric: &FabricConfig) -> Result<ReadBack, LabError> {
-    let mut runs = Runs { fabric, tensile: BTreeMap::new(), bending: BTreeMap::new(), shear: None };
+    readback_with(sheets, import, fabric, LabRuns::default())
+}
+
+/// [`readback`], reading the tests in `done` instead of running them again.
+pub fn readback_with(sheets: &Sheets, import: &Import, fabric: &FabricConfig, done: LabRuns) -> Result<ReadBack, LabError> {
+    let mut runs = Runs { fabric, done };
     let mut out = ReadBack::default();
     let mut push = |field: String, unit, sheet, measured, test, tolerance| {
         out.properties.push(Property { field, unit, sheet, measured, test, tolerance });
@@ -153,22 +178,22 @@ pub fn readback(sheets: &Sheets, import: &Import, fabric: &FabricConfig) -> Resu
             Some(SheetKind::Fast) => {
                 let fast = sheets.fast.as_ref().expect("the supplier exists");
                 if let Some(c) = fast.si(&format!("C_{dir}")) {
-                    let t = cantilever_bending_length(fabric, d, STANDARD_STRIP_WIDTH)?;
-                    push(format!("fast.C_{dir}"), "mm", 1e3 * c, 1e3 * t.bending_length, "cantilever", 0.03);
+                    let c_virtual = runs.cantilever(d, STANDARD_STRIP_WIDTH)?;
+                    push(format!("fast.C_{dir}"), "mm", 1e3 * c, 1e3 * c_virtual, "cantilever", 0.03);
                 } else if let Some(b) = fast.si(&format!("B_{dir}")) {
                     push(format!("fast.B_{dir}"), "µN·m", 1e6 * b, 1e6 * runs.bending(d)?.rigidity, "pure bending", 0.02);
                 }
             }
             Some(SheetKind::Cantilever) => {
                 let cant = sheets.cantilever.as_ref().expect("the supplier exists");
-                push_cantilever(&mut push, cant, fabric, dir, d)?;
+                push_cantilever(&mut push, cant, &mut runs, dir, d)?;
             }
             None => {}
         }
     }
     if supplier(import, "bending_bias") == Some(SheetKind::Cantilever) {
         let cant = sheets.cantilever.as_ref().expect("the supplier exists");
-        push_cantilever(&mut push, cant, fabric, "bias", Direction::Bias)?;
+        push_cantilever(&mut push, cant, &mut runs, "bias", Direction::Bias)?;
     }
     match supplier(import, "shear_modulus") {
         Some(SheetKind::Kes) => {
@@ -194,7 +219,7 @@ pub fn readback(sheets: &Sheets, import: &Import, fabric: &FabricConfig) -> Resu
 fn push_cantilever(
     push: &mut impl FnMut(String, &'static str, f64, f64, &'static str, f64),
     cant: &crate::fabric::sheet::Section,
-    fabric: &FabricConfig,
+    runs: &mut Runs,
     dir: &str,
     d: Direction,
 ) -> Result<(), LabError> {
@@ -204,7 +229,7 @@ fn push_cantilever(
         (None, None) => return Ok(()),
     };
     let width = cant.si("strip_width").unwrap_or(STANDARD_STRIP_WIDTH);
-    let t = cantilever_bending_length(fabric, d, width)?;
-    push(format!("cantilever.c_{dir}"), "mm", 1e3 * c, 1e3 * t.bending_length, "cantilever", 0.03);
+    let bending_length = runs.cantilever(d, width)?;
+    push(format!("cantilever.c_{dir}"), "mm", 1e3 * c, 1e3 * bending_length, "cantilever", 0.03);
     Ok(())
 }

@@ -92,3 +92,38 @@ pub fn kes_tensile(fabric: &FabricConfig, direction: Direction) -> Result<KesTen
     }
     Err(LabError::NoReading { test: TEST, message: "the strip did not reach 500 gf/cm by 100 % strain".into() })
 }
+
+/// What a strip pull to a given strain reports: the tensile rig's own measures.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TensilePull {
+    pub direction: Direction,
+    /// The strain the clamp pulled to (by the clamps' separation), a fraction.
+    pub max_strain: f64,
+    /// (extensometer strain, stress N/m) from the unloaded start, then the rig's few dozen
+    /// points evenly spaced in time (`TensileMeasures::stress_strain`).
+    pub curve: Vec<[f64; 2]>,
+    /// −lateral strain over extensometer strain at the end of the pull.
+    pub poisson_ratio: f64,
+}
+
+/// Pulls a strip of `fabric` cut along `direction` on the `tensile-warp` rig (10 cm gauge,
+/// 5 cm wide, 1 mm/s) to `max_strain` and returns the rig's stress–strain curve. Unlike
+/// [`kes_tensile`] it stops at a strain, not a load: a bias strip, which shears rather than
+/// stretches its yarns, may not reach KES's 500 gf/cm before it has doubled in length.
+pub fn tensile_pull(fabric: &FabricConfig, direction: Direction, max_strain: f64) -> Result<TensilePull, LabError> {
+    const TEST: &str = "tensile pull";
+    if !(max_strain.is_finite() && max_strain > 0.0 && max_strain <= 1.0) {
+        return Err(LabError::Setup { test: TEST, message: format!("the strain to pull to must be in (0, 1], got {max_strain}") });
+    }
+    let config = scene_config(TEST, "tensile-warp", fabric, |c| {
+        c.cloth.warp_angle_deg = direction.warp_angle_deg();
+        c.test.max_strain = Some(max_strain);
+        c.scene.duration = max_strain * c.cloth.length / c.test.speed.unwrap_or(0.001);
+        c.scene.settle_speed = None;
+    })?;
+    let m = super::run(TEST, config)?;
+    let t = m.measures.tensile().ok_or_else(|| LabError::NoReading { test: TEST, message: "the rig reported no tensile measures".into() })?;
+    // The rig samples after its steps; the strip starts unloaded and unstretched.
+    let curve = std::iter::once([0.0, 0.0]).chain(t.stress_strain.iter().copied().filter(|p| p[0] > 0.0)).collect();
+    Ok(TensilePull { direction, max_strain, curve, poisson_ratio: t.poisson_ratio })
+}

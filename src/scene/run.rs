@@ -110,6 +110,9 @@ pub struct RunOptions<'a> {
     pub max_steps: Option<u64>,
     /// Wall-clock seconds after which the run stops; unbounded when `None`.
     pub max_wall_seconds: Option<f64>,
+    /// Called after every step that stood, with the scene as it is then (`rosette run
+    /// --export-frames` samples the cloth from it).
+    pub on_state: Option<&'a mut dyn FnMut(&Scene)>,
 }
 
 
@@ -248,6 +251,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let end_time = scene.state.time + duration;
     let mut progress = options.progress;
     let mut on_step = options.on_step;
+    let mut on_state = options.on_state;
     let wall = Instant::now();
     let cpu = cpu_time::ProcessTime::now();
     let start_time = scene.state.time;
@@ -303,6 +307,9 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
                 cpu_seconds: cpu.elapsed().as_secs_f64(),
                 timings: report.timings,
             });
+        }
+        if let Some(f) = on_state.as_deref_mut() {
+            f(scene);
         }
         if settle.observe(scene, rms).is_some() {
             break;

@@ -1,0 +1,325 @@
+//! The cloth out to other tools: glTF 2.0 binary (`.glb`), which Blender, three.js and web
+//! viewers open (`rosette run --export`, the viewer's File menu).
+//!
+//! What the file holds: one mesh, the cloth, with positions, unit vertex normals (area
+//! weighted over the triangles round each vertex), texture coordinates in the warp/weft
+//! frame and the plain-weave texture (`assets/weave.png`, embedded) on a two-sided material in
+//! the renderer's cloth colour. Texture u runs along the warp and v along the weft, scaled as
+//! the renderer scales them: one repeat of the texture (four yarns) per
+//! `RenderOptions::weave_period` = 4 mm, so the yarns lie 1 mm apart. Metres, and y up as
+//! glTF has it (the scenes' z up becomes y; the scenes' y becomes −z).
+//!
+//! Several frames make an animation: the first frame is the mesh and every later frame a
+//! morph target (its positions and normals less the first's), and one animation steps the
+//! targets' weights through them at the frames' simulated times, linearly, so that frame k
+//! has weight 1 on target k − 1 and 0 elsewhere. Blender imports the targets as shape keys
+//! driven by an action, three.js as morph targets played by its AnimationMixer.
+
+use crate::render::{Frame, RenderOptions};
+use glam::{DVec2, DVec3};
+use serde_json::{Value, json};
+use std::path::Path;
+use thiserror::Error;
+
+/// The plain-weave texture, embedded in every file.
+const WEAVE_PNG: &[u8] = include_bytes!("../assets/weave.png");
+
+/// glTF's component types and buffer targets (glTF 2.0 §5).
+const FLOAT: u32 = 5126;
+const UNSIGNED_INT: u32 = 5125;
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+
+#[derive(Debug, Error)]
+pub enum ExportError {
+    #[error("nothing to export: {0}")]
+    Empty(String),
+    #[error("cannot write {path}: {message}")]
+    Write { path: String, message: String },
+}
+
+/// The cloth's topology and rest shape, which every frame shares.
+#[derive(Debug, Clone, Copy)]
+pub struct Cloth<'a> {
+    /// Triangles, counter-clockwise in the rest plane (the front face's winding).
+    pub triangles: &'a [[u32; 3]],
+    /// Rest positions in the sample plane, m.
+    pub rest: &'a [DVec2],
+    /// Angle of the warp from the rest x axis, radians (`sim::Model::warp_angle`).
+    pub warp_angle: f64,
+    /// The mesh's name in the file.
+    pub name: &'a str,
+}
+
+/// One moment of the cloth: simulated time (s) and vertex positions (m, z up).
+pub type ClothFrame = (f64, Vec<DVec3>);
+
+/// A scene's position in glTF's frame: y up, right-handed.
+fn to_gltf(p: DVec3) -> [f32; 3] {
+    [p.x as f32, p.z as f32, -p.y as f32]
+}
+
+/// Unit vertex normals, in glTF's frame: each vertex the area-weighted sum of its
+/// triangles' normals (a vertex with no area round it gets +y).
+pub fn vertex_normals(x: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[f32; 3]> {
+    let mut sum = vec![DVec3::ZERO; x.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| x[i as usize]);
+        // Twice the area times the unit normal.
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            sum[i as usize] += n;
+        }
+    }
+    sum.into_iter().map(|n| to_gltf(n.try_normalize().unwrap_or(DVec3::Z))).map(|n| {
+        // Renormalised in single precision, so that readers find them unit to f32's precision.
+        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        n.map(|c| c / l)
+    })
+    .collect()
+}
+
+/// The binary chunk under construction and the JSON's views and accessors into it.
+#[derive(Default)]
+struct Builder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Builder {
+    /// Appends `bytes` as a buffer view (4-byte aligned) and returns its index.
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let mut view = json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
+        if let Some(t) = target {
+            view["target"] = json!(t);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(view);
+        self.views.len() - 1
+    }
+
+    /// A float accessor of `kind` (`VEC3`, `VEC2`, `SCALAR`) over `values`, with its bounds
+    /// (glTF requires them for positions and animation inputs; they are written for all).
+    fn floats<const N: usize>(&mut self, values: &[[f32; N]], kind: &str, target: Option<u32>) -> usize {
+        let bytes: Vec<u8> = values.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.view(&bytes, target);
+        let mut lo = [f32::INFINITY; N];
+        let mut hi = [f32::NEG_INFINITY; N];
+        for v in values {
+            for k in 0..N {
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+        }
+        self.accessors.push(json!({
+            "bufferView": view, "componentType": FLOAT, "count": values.len(), "type": kind,
+            "min": lo.to_vec(), "max": hi.to_vec(),
+        }));
+        self.accessors.len() - 1
+    }
+}
+
+/// The file's bytes: `frames` of `cloth` (one frame: a still; more: an animation).
+pub fn glb(cloth: &Cloth, frames: &[ClothFrame]) -> Result<Vec<u8>, ExportError> {
+    let Some((_, first)) = frames.first() else { return Err(ExportError::Empty("no frame".into())) };
+    if first.is_empty() || cloth.triangles.is_empty() {
+        return Err(ExportError::Empty("the cloth has no triangles".into()));
+    }
+    if let Some((t, x)) = frames.iter().find(|(_, x)| x.len() != first.len() || x.iter().any(|p| !p.is_finite())) {
+        return Err(ExportError::Empty(format!("the frame at t = {t} s has {} vertices or a position that is not finite", x.len())));
+    }
+    let mut b = Builder::default();
+    let indices: Vec<u8> = cloth.triangles.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+    let index_view = b.view(&indices, Some(ELEMENT_ARRAY_BUFFER));
+    b.accessors.push(json!({ "bufferView": index_view, "componentType": UNSIGNED_INT, "count": 3 * cloth.triangles.len(), "type": "SCALAR" }));
+    let positions: Vec<[f32; 3]> = first.iter().map(|&p| to_gltf(p)).collect();
+    let normals = vertex_normals(first, cloth.triangles);
+    let period = f64::from(RenderOptions::default().weave_period);
+    let uv: Vec<[f32; 2]> = Frame::from_cloth(first, cloth.triangles, cloth.rest, cloth.warp_angle)
+        .cloth_uv
+        .iter()
+        .map(|[u, v]| [(f64::from(*u) / period) as f32, (f64::from(*v) / period) as f32])
+        .collect();
+    let position = b.floats(&positions, "VEC3", Some(ARRAY_BUFFER));
+    let normal = b.floats(&normals, "VEC3", Some(ARRAY_BUFFER));
+    let texcoord = b.floats(&uv, "VEC2", Some(ARRAY_BUFFER));
+    let mut primitive = json!({
+        "attributes": { "POSITION": position, "NORMAL": normal, "TEXCOORD_0": texcoord },
+        "indices": 0, "material": 0, "mode": 4,
+    });
+    let mut mesh = json!({ "name": cloth.name, "primitives": [] });
+    let mut animations = Vec::new();
+    if frames.len() > 1 {
+        let mut targets = Vec::new();
+        let mut names = Vec::new();
+        for (t, x) in &frames[1..] {
+            let delta: Vec<[f32; 3]> = x.iter().zip(&positions).map(|(&p, q)| {
+                let p = to_gltf(p);
+                [p[0] - q[0], p[1] - q[1], p[2] - q[2]]
+            })
+            .collect();
+            let n = vertex_normals(x, cloth.triangles);
+            let n_delta: Vec<[f32; 3]> = n.iter().zip(&normals).map(|(a, b)| [a[0] - b[0], a[1] - b[1], a[2] - b[2]]).collect();
+            targets.push(json!({ "POSITION": b.floats(&delta, "VEC3", Some(ARRAY_BUFFER)), "NORMAL": b.floats(&n_delta, "VEC3", Some(ARRAY_BUFFER)) }));
+            names.push(format!("t = {t:.3} s"));
+        }
+        let count = targets.len();
+        primitive["targets"] = json!(targets);
+        mesh["weights"] = json!(vec![0.0; count]);
+        // Blender names the shape keys from here.
+        mesh["extras"] = json!({ "targetNames": names });
+        let start = frames[0].0;
+        let times: Vec<[f32; 1]> = frames.iter().map(|(t, _)| [(t - start) as f32]).collect();
+        let weights: Vec<[f32; 1]> = (0..frames.len()).flat_map(|k| (0..count).map(move |j| [if k == j + 1 { 1.0 } else { 0.0 }])).collect();
+        let input = b.floats(&times, "SCALAR", None);
+        let output = b.floats(&weights, "SCALAR", None);
+        animations.push(json!({
+            "name": "drape",
+            "samplers": [{ "input": input, "output": output, "interpolation": "LINEAR" }],
+            "channels": [{ "sampler": 0, "target": { "node": 0, "path": "weights" } }],
+        }));
+    }
+    mesh["primitives"] = json!([primitive]);
+    let image_view = b.view(WEAVE_PNG, None);
+    let [r, g, bl] = RenderOptions::default().front_color.map(srgb_to_linear);
+    let mut document = json!({
+        "asset": { "version": "2.0", "generator": format!("rosette {}", env!("CARGO_PKG_VERSION")) },
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "mesh": 0, "name": cloth.name }],
+        "meshes": [mesh],
+        "materials": [{
+            "name": "woven cloth",
+            "doubleSided": true,
+            "pbrMetallicRoughness": { "baseColorFactor": [r, g, bl, 1.0], "baseColorTexture": { "index": 0 }, "metallicFactor": 0.0, "roughnessFactor": 0.9 },
+        }],
+        // Linear filtering with mipmaps, repeating both ways: the weave tiles the cloth.
+        "samplers": [{ "magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497 }],
+        "images": [{ "bufferView": image_view, "mimeType": "image/png", "name": "plain weave, 4 yarns each way" }],
+        "textures": [{ "sampler": 0, "source": 0 }],
+        "accessors": b.accessors,
+        "bufferViews": b.views,
+        "buffers": [{ "byteLength": 0 }],
+    });
+    if !animations.is_empty() {
+        document["animations"] = json!(animations);
+    }
+    while !b.bin.len().is_multiple_of(4) {
+        b.bin.push(0);
+    }
+    document["buffers"][0]["byteLength"] = json!(b.bin.len());
+    let mut text = serde_json::to_vec(&document).expect("JSON values serialise");
+    while !text.len().is_multiple_of(4) {
+        text.push(b' ');
+    }
+    // GLB: a 12-byte header, then the JSON chunk and the binary chunk (glTF 2.0 §4.4).
+    let total = 12 + 8 + text.len() + 8 + b.bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&text);
+    out.extend_from_slice(&(b.bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&b.bin);
+    Ok(out)
+}
+
+/// Writes [`glb`] to `path`.
+pub fn write_glb(path: &Path, cloth: &Cloth, frames: &[ClothFrame]) -> Result<(), ExportError> {
+    let bytes = glb(cloth, frames)?;
+    std::fs::write(path, bytes).map_err(|e| ExportError::Write { path: path.display().to_string(), message: e.to_string() })
+}
+
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Keeps the cloth's positions through a run for an animation of `frames` frames spread
+/// evenly over however long the run turns out (a drape may settle early): it samples eight
+/// times as often as the frames need and picks the frames from the samples at the end.
+#[derive(Debug, Clone)]
+pub struct Recorder {
+    frames: usize,
+    spacing: f64,
+    next: f64,
+    samples: Vec<ClothFrame>,
+}
+
+impl Recorder {
+    /// For a run from `start` lasting at most `duration` seconds.
+    pub fn new(frames: usize, start: f64, duration: f64) -> Self {
+        let frames = frames.max(2);
+        Self { frames, spacing: duration / (8 * (frames - 1)) as f64, next: start, samples: Vec::new() }
+    }
+
+    /// Takes the state at `time` if a sample is due.
+    pub fn observe(&mut self, time: f64, x: &[DVec3]) {
+        if time + 1e-9 >= self.next {
+            self.samples.push((time, x.to_vec()));
+            while self.next <= time + 1e-9 {
+                self.next += self.spacing.max(f64::MIN_POSITIVE);
+            }
+        }
+    }
+
+    /// The frames: the state at `time` last, and those samples nearest in time to evenly
+    /// spaced moments before it, each at most once (fewer frames than asked for only when
+    /// the run was shorter than its sampling).
+    pub fn finish(mut self, time: f64, x: &[DVec3]) -> Vec<ClothFrame> {
+        if self.samples.last().is_none_or(|(t, _)| *t < time) {
+            self.samples.push((time, x.to_vec()));
+        }
+        let start = self.samples[0].0;
+        let mut picked: Vec<usize> = (0..self.frames)
+            .map(|k| {
+                let target = start + (time - start) * k as f64 / (self.frames - 1) as f64;
+                let i = self.samples.partition_point(|(t, _)| *t < target);
+                // The nearer of the samples either side.
+                match (i.checked_sub(1), self.samples.get(i)) {
+                    (Some(j), Some((t, _))) if target - self.samples[j].0 < t - target => j,
+                    (_, Some(_)) => i,
+                    (Some(j), None) => j,
+                    (None, None) => 0,
+                }
+            })
+            .collect();
+        picked.dedup();
+        let mut samples: Vec<Option<ClothFrame>> = self.samples.into_iter().map(Some).collect();
+        picked.into_iter().filter_map(|i| samples[i].take()).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normals_of_a_flat_sheet_point_up_in_gltf() {
+        let x = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        // Counter-clockwise seen from +z: the normal is +z, which glTF calls +y.
+        assert_eq!(vertex_normals(&x, &[[0, 1, 2]]), vec![[0.0, 1.0, 0.0]; 3]);
+    }
+
+    #[test]
+    fn the_recorder_spreads_its_frames_over_the_run_it_saw() {
+        let mut r = Recorder::new(5, 0.0, 1.0);
+        let x = [DVec3::ZERO];
+        // A run that stops at 0.5 s of its 1 s, in 0.01 s steps.
+        for k in 1..=50 {
+            r.observe(k as f64 * 0.01, &x);
+        }
+        let frames = r.finish(0.5, &x);
+        let times: Vec<f64> = frames.iter().map(|f| f.0).collect();
+        assert_eq!(times.len(), 5);
+        for (t, want) in times.iter().zip([0.01, 0.13, 0.26, 0.38, 0.5]) {
+            assert!((t - want).abs() <= 0.0126, "{times:?}");
+        }
+    }
+}
