@@ -62,11 +62,21 @@ fn presets_lists_every_bundled_scene() {
 /// Runs `rosette run NAME --metrics FILE` and checks the report against the preset's own
 /// input data: its integrator and step, a run to the end of its duration, stable.
 fn run_bundled(name: &str) {
-    let (config, _) = load_scene(name, &[]).unwrap();
+    run_bundled_with(name, &[]);
+}
+
+/// `run_bundled` with `--set` overrides, checked against the scene they make.
+fn run_bundled_with(name: &str, overrides: &[&str]) {
+    let owned: Vec<String> = overrides.iter().map(|o| o.to_string()).collect();
+    let (config, _) = load_scene(name, &owned).unwrap();
     let scene = Scene::build(config.clone()).unwrap();
     let path = metrics_path(name);
     let started = Instant::now();
-    let out = rosette(&["run", name, "--metrics", path.to_str().unwrap()]);
+    let mut args = vec!["run", name, "--metrics", path.to_str().unwrap()];
+    for o in overrides {
+        args.extend(["--set", o]);
+    }
+    let out = rosette(&args);
     let elapsed = started.elapsed().as_secs_f64();
     eprintln!("rosette run {name}: {elapsed:.1} s wall");
     assert_eq!(out.status.code(), Some(0), "{name}: {}", text(&out.stderr));
@@ -124,7 +134,7 @@ fn run_bundled(name: &str) {
 }
 
 /// Every bundled scene has its own test below (so that they run in parallel).
-const COVERED: [&str; 10] = [
+const COVERED: [&str; 11] = [
     "tensile-warp",
     "tensile-weft",
     "tensile-bias",
@@ -135,6 +145,7 @@ const COVERED: [&str; 10] = [
     "cusick-drape",
     "cusick-drape-30",
     "tablecloth",
+    "sphere-drop",
 ];
 
 #[test]
@@ -187,6 +198,13 @@ fn runs_cusick_drape_30() {
 #[test]
 fn runs_tablecloth() {
     run_bundled("tablecloth");
+}
+
+/// The sphere drop on 4 cm edges (1 250 triangles): its own 8 000 triangles take minutes on
+/// the exact path (the bench runs it, docs/fast-path.md).
+#[test]
+fn runs_sphere_drop() {
+    run_bundled_with("sphere-drop", &["mesh.edge_length=0.04"]);
 }
 
 /// `--outline` writes the shadow outline of a drape: one row per half degree, radii between

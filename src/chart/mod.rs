@@ -192,11 +192,10 @@ impl Plan {
                 if i == 0 && !quick && problem != Problem::Drape {
                     accuracy.push(case(problem, SymplecticEuler, Step::OfLimit(0.45), edge));
                 }
-                // The equilibrium problems on the fast path, at its own step, beside exact
-                // Newton on the same meshes.
+                // The equilibrium problems on the fast path as `--fast` runs them (its step
+                // chosen per level), beside exact Newton on the same meshes.
                 if matches!(problem, Problem::Cantilever | Problem::Drape) {
-                    let fast_step = crate::scene::levels::FastSettings::default().dt;
-                    accuracy.push(Case { path: SolverPath::Fast, ..case(problem, ImplicitEuler, Step::Seconds(fast_step), edge) });
+                    accuracy.push(Case { path: SolverPath::Fast, ..case(problem, ImplicitEuler, Step::Scene, edge) });
                 }
             }
         }

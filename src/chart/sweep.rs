@@ -92,6 +92,10 @@ impl Problem {
 pub enum Step {
     Seconds(f64),
     OfLimit(f64),
+    /// The scene's own step, left to the solver path: the fast path's runs, which choose
+    /// their step per level as `rosette run --fast` does. The table records the step the
+    /// run ended on.
+    Scene,
 }
 
 /// One run to make.
@@ -140,6 +144,7 @@ impl Case {
         let step = match self.step {
             Step::Seconds(dt) => format!("dt {dt:.1e} s"),
             Step::OfLimit(factor) => format!("dt {factor}x its limit"),
+            Step::Scene => "the scene's dt".into(),
         };
         let millimetres = (self.edge_length * 1e4).round() / 10.0;
         let mut label = format!("{} {} {step}, {millimetres} mm edges", self.problem.name(), self.integrator);
@@ -155,13 +160,15 @@ impl Case {
         label
     }
 
-    /// The scene of this case with time step `dt`.
-    fn config(&self, dt: f64) -> Result<SceneConfig, String> {
+    /// The scene of this case with time step `dt` (None: the scene's own).
+    fn config(&self, dt: Option<f64>) -> Result<SceneConfig, String> {
         let mut overrides: Vec<String> = self.problem.overrides().iter().map(|s| s.to_string()).collect();
         overrides.push(format!("mesh.edge_length={}", self.edge_length));
         overrides.push(format!("solver.integrator={}", self.integrator.name()));
         overrides.push(format!("solver.path={}", self.path.name()));
-        overrides.push(format!("solver.dt={dt}"));
+        if let Some(dt) = dt {
+            overrides.push(format!("solver.dt={dt}"));
+        }
         // An explicit run at a fraction of its stability limit takes as many steps as that
         // needs (tens of millions on the stiffest maps): the sweep's cases are bounded by
         // construction, not by the command line's default step bound.
@@ -191,7 +198,7 @@ impl Case {
 
     fn run_into(&self, outcome: &mut Outcome) -> Result<(), String> {
         // The model does not depend on dt: build it once at a nominal step for the limit.
-        let probe = Scene::build(self.config(1e-3)?).map_err(|e| e.to_string())?;
+        let probe = Scene::build(self.config(Some(1e-3))?).map_err(|e| e.to_string())?;
         outcome.explicit_limit = explicit_limit(&probe);
         outcome.triangles = probe.model.triangle_count();
         let f = &probe.config.fabric.properties;
@@ -199,15 +206,16 @@ impl Case {
         outcome.tensile_stiffness = (b[1] - a[1]) / (b[0] - a[0]);
         outcome.bending_stiffness = f.bending_warp;
         let dt = match self.step {
-            Step::Seconds(dt) => dt,
-            Step::OfLimit(factor) => factor * outcome.explicit_limit,
+            Step::Seconds(dt) => Some(dt),
+            Step::OfLimit(factor) => Some(factor * outcome.explicit_limit),
+            Step::Scene => None,
         };
-        outcome.dt = dt;
         let config = self.config(dt)?;
         let mut scene = Scene::build(config.clone()).map_err(|e| e.to_string())?;
         let cpu = cpu_time::ThreadTime::now();
         let (metrics, error) = run_scene(&mut scene, self.problem.name(), RunOptions::default());
         outcome.cpu_seconds = cpu.elapsed().as_secs_f64();
+        outcome.dt = scene.integrator.dt;
         if let Some(e) = error {
             outcome.diverged = true;
             outcome.message = Some(e.to_string());

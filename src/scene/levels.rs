@@ -15,9 +15,12 @@
 //! ```
 //!
 //! Each level halves the edge of the one before, so the transfer leaves every level only
-//! the folds its coarser neighbour could not resolve to relax. All levels run at the fast
-//! path's time step (`solver.fast.dt`), on which implicit Euler is as stable as on the
-//! exact path's.
+//! the folds its coarser neighbour could not resolve to relax. Levels that resolve the folds
+//! run at the fast path's long time step (`solver.fast.dt`), on which implicit Euler is as
+//! stable as on the exact path's; a scene whose mesh is coarser than that keeps its own
+//! step. A cloth dropped onto props (no gravity ramp) takes the long step on every level,
+//! with the contact penalty rescaled to keep its stiffness ([`level_config`]), and on every
+//! level Newton stops at the step's own accuracy (`solver.fast.error_share`).
 
 use super::run::SettleWatch;
 use super::{Scene, SceneConfig, SceneError};

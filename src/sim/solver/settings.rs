@@ -11,7 +11,8 @@ pub struct NewtonSettings {
     /// Newton stops when no vertex moves more than this fraction of the mean edge length.
     pub tolerance: f64,
     /// Newton also stops at a step under this share of the step's own integration error,
-    /// implicit Euler's local error ½h·max|v_{n+1} − v_n| as the last step left it: a solve
+    /// implicit Euler's local error ½h·max|v_{n+1} − v_n|, estimated at each iterate and at
+    /// most the last step's (an iterate far from the solution cannot loosen it): a solve
     /// an order of magnitude more exact than the step it serves adds nothing a user could
     /// see in a moving cloth, and its last iterations are most of a dynamic step's cost. At
     /// rest that error vanishes and `tolerance` alone decides, so equilibria are found as

@@ -1,0 +1,123 @@
+//! The fast path (`solver.path = "fast"`, docs/fast-path.md) against the exact one: a drape
+//! settled coarse to fine at long steps lands inside the exact path's scatter between random
+//! starts and inside its fabric's measured class (docs/references.md §7), clean (no
+//! self-intersection, no penetration); a cloth dropped at long steps, its contact penalty
+//! rescaled, stays out of its prop; scenes that do not settle (the laboratory's rigs) run
+//! exactly as on the exact path; and a path the integrator cannot take is refused.
+
+use rosette::scene::levels::schedule;
+use rosette::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
+
+fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Metrics) {
+    let (config, _) = load_scene(preset, overrides).unwrap_or_else(|e| panic!("{e}"));
+    let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
+    let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
+    assert!(error.is_none(), "{preset} {overrides:?}: {error:?}");
+    (config, metrics)
+}
+
+/// Runs `preset` for several override sets on both cores.
+fn run_all(preset: &str, sets: Vec<Vec<String>>) -> Vec<(SceneConfig, Metrics)> {
+    std::thread::scope(|s| {
+        let handles: Vec<_> = sets.iter().map(|o| s.spawn(move || run(preset, o))).collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    })
+}
+
+fn drape_coefficient(m: &Metrics) -> f64 {
+    m.measures.drape().expect("drape measures").drape_coefficient
+}
+
+/// Issue 23's criterion: over the same seeds, the fast path's coefficients lie within 0.02
+/// of the exact path's range on the same mesh.
+const PATH_MARGIN: f64 = 0.02;
+
+/// The standard 30 cm specimen of denim on 6 mm edges (3 929 triangles), seeds 1 and 2 on
+/// each path: the fast path settles it first on 12 mm edges, inside half denim's bending
+/// length (25 mm), then on the scene's mesh. Denim's measured class is 0.7–0.9
+/// (docs/references.md §7).
+#[test]
+fn fast_drape_lies_within_the_exact_paths_seed_scatter_and_its_measured_class() {
+    let fabric = "fabric.preset=denim".to_string();
+    let mesh = "mesh.edge_length=0.006".to_string();
+    let (config, _) = load_scene("cusick-drape-30", &[fabric.clone(), mesh.clone(), "solver.path=fast".into()]).unwrap();
+    let levels = schedule(&config).unwrap().expect("a drape settles, so the fast path has levels");
+    assert!(levels.len() >= 2, "6 mm edges should settle through a coarser mesh first: {levels:?}");
+
+    let sets = [("exact", 1), ("exact", 2), ("fast", 1), ("fast", 2)]
+        .iter()
+        .map(|(path, seed)| vec![fabric.clone(), mesh.clone(), format!("solver.path={path}"), format!("scene.seed={seed}")])
+        .collect();
+    let results = run_all("cusick-drape-30", sets);
+    let (exact, fast) = results.split_at(2);
+    let exact_dc: Vec<f64> = exact.iter().map(|(_, m)| drape_coefficient(m)).collect();
+    let (low, high) = (exact_dc[0].min(exact_dc[1]), exact_dc[0].max(exact_dc[1]));
+    for (i, (config, m)) in fast.iter().enumerate() {
+        let dc = drape_coefficient(m);
+        let nodes = m.measures.drape().unwrap().nodes;
+        println!(
+            "seed {}: fast DC {dc:.4} ({nodes} nodes, {:.2} s wall, {} steps), exact {:.4} ({:.2} s wall, {} steps)",
+            i + 1,
+            m.wall_seconds,
+            m.steps,
+            exact_dc[i],
+            exact[i].1.wall_seconds,
+            exact[i].1.steps
+        );
+        assert_eq!(m.triangles, exact[i].1.triangles, "the fast path ends on the scene's own mesh");
+        assert_eq!(m.settled, Some(true), "seed {}: never settled", i + 1);
+        assert!(m.converged && m.stable, "seed {}: converged {} stable {}", i + 1, m.converged, m.stable);
+        assert!(
+            dc >= low - PATH_MARGIN && dc <= high + PATH_MARGIN,
+            "seed {}: fast DC {dc:.4} outside the exact range [{low:.4}, {high:.4}] ± {PATH_MARGIN}",
+            i + 1
+        );
+        assert!((0.7..=0.9).contains(&dc), "seed {}: DC {dc:.4} outside denim's measured 0.7–0.9", i + 1);
+        assert!((4..=10).contains(&nodes), "seed {}: {nodes} nodes", i + 1);
+        assert_eq!(m.self_intersections, Some(0), "seed {}", i + 1);
+        assert!(m.max_penetration.unwrap() < config.contact.thickness, "seed {}: {:?}", i + 1, m.max_penetration);
+    }
+}
+
+/// A tablecloth dropped onto its table at the fast path's long steps, the contact penalty
+/// raised with the square of the step: it lands, stays out of the table and itself, and
+/// settles hanging (its drape coefficient against the table top below one).
+#[test]
+fn a_cloth_dropped_at_long_steps_stays_out_of_its_prop_and_itself() {
+    let (config, m) = run("tablecloth", &["mesh.edge_length=0.035".into(), "solver.path=fast".into()]);
+    let dc = drape_coefficient(&m);
+    println!(
+        "tablecloth, 3.5 cm edges, fast: DC {dc:.3}, penetration {:?}, settled at {:?} s, {:.2} s wall",
+        m.max_penetration, m.settle_time, m.wall_seconds
+    );
+    assert!(m.dt > config.solver.dt, "the drop takes long steps: {} s", m.dt);
+    assert!(m.converged && m.stable);
+    assert_eq!(m.settled, Some(true));
+    assert_eq!(m.self_intersections, Some(0));
+    assert!(m.max_penetration.unwrap() < config.contact.thickness, "{:?}", m.max_penetration);
+    assert!(dc > 0.0 && dc < 1.0, "DC {dc}");
+}
+
+/// The laboratory's rigs load the specimen as the experiment: they do not settle, and the
+/// fast path leaves them as they are, to the last digit.
+#[test]
+fn scenes_that_do_not_settle_run_the_same_on_both_paths() {
+    let results = run_all("tensile-warp", vec![vec![], vec!["solver.path=fast".into()]]);
+    let (exact, fast) = (&results[0].1, &results[1].1);
+    assert_eq!(exact.steps, fast.steps);
+    assert_eq!(exact.newton_iterations, fast.newton_iterations);
+    let json = |m: &Metrics| serde_json::to_string(&m.measures).unwrap();
+    assert_eq!(json(exact), json(fast));
+}
+
+/// The fast path takes implicit steps; with an explicit integrator it is refused up front,
+/// naming the keys.
+#[test]
+fn the_fast_path_with_an_explicit_integrator_is_refused() {
+    let (config, _) = load_scene("cusick-drape", &["solver.path=fast".into(), "solver.integrator=symplectic-euler".into()]).unwrap();
+    let message = match Scene::build(config) {
+        Ok(_) => panic!("built"),
+        Err(e) => e.to_string(),
+    };
+    assert!(message.contains("solver.path") && message.contains("solver.integrator"), "{message}");
+}
