@@ -7,26 +7,11 @@
 mod common;
 
 use common::reference::{bending_rigidity_theta, independent_strip_drape_lower_bound};
-use rosette::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
-
-fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Metrics) {
-    let (config, _) = load_scene(preset, overrides).unwrap_or_else(|e| panic!("{e}"));
-    let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
-    let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
-    assert!(error.is_none(), "{preset} {overrides:?}: {error:?}");
-    (config, metrics)
-}
+use common::run_all;
+use rosette::scene::{Metrics, SceneConfig};
 
 fn drape_coefficient(m: &Metrics) -> f64 {
     m.measures.drape().expect("drape measures").drape_coefficient
-}
-
-/// Runs `preset` for several override sets on both cores.
-fn run_all(preset: &str, sets: Vec<Vec<String>>) -> Vec<(SceneConfig, Metrics)> {
-    std::thread::scope(|s| {
-        let handles: Vec<_> = sets.iter().map(|o| s.spawn(move || run(preset, o))).collect();
-        handles.into_iter().map(|h| h.join().unwrap()).collect()
-    })
 }
 
 /// Bending length c = (B/w)^(1/3) with B the mean of warp and weft rigidities.

@@ -5,24 +5,11 @@
 //! rescaled, stays out of its prop; scenes that do not settle (the laboratory's rigs) run
 //! exactly as on the exact path; and a path the integrator cannot take is refused.
 
+mod common;
+
+use common::{run, run_all};
 use rosette::scene::levels::schedule;
-use rosette::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
-
-fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Metrics) {
-    let (config, _) = load_scene(preset, overrides).unwrap_or_else(|e| panic!("{e}"));
-    let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
-    let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
-    assert!(error.is_none(), "{preset} {overrides:?}: {error:?}");
-    (config, metrics)
-}
-
-/// Runs `preset` for several override sets on both cores.
-fn run_all(preset: &str, sets: Vec<Vec<String>>) -> Vec<(SceneConfig, Metrics)> {
-    std::thread::scope(|s| {
-        let handles: Vec<_> = sets.iter().map(|o| s.spawn(move || run(preset, o))).collect();
-        handles.into_iter().map(|h| h.join().unwrap()).collect()
-    })
-}
+use rosette::scene::{Metrics, Scene, load_scene};
 
 fn drape_coefficient(m: &Metrics) -> f64 {
     m.measures.drape().expect("drape measures").drape_coefficient

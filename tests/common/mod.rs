@@ -5,3 +5,23 @@
 #![allow(dead_code)]
 
 pub mod reference;
+
+use rosette::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
+
+/// Runs `preset` with `--set` style `overrides` to the end of its scene, which must not
+/// diverge.
+pub fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Metrics) {
+    let (config, _) = load_scene(preset, overrides).unwrap_or_else(|e| panic!("{e}"));
+    let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
+    let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
+    assert!(error.is_none(), "{preset} {overrides:?}: {error:?}");
+    (config, metrics)
+}
+
+/// Runs `preset` for several override sets, one thread each (both cores).
+pub fn run_all(preset: &str, sets: Vec<Vec<String>>) -> Vec<(SceneConfig, Metrics)> {
+    std::thread::scope(|s| {
+        let handles: Vec<_> = sets.iter().map(|o| s.spawn(move || run(preset, o))).collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    })
+}
