@@ -59,8 +59,13 @@ impl SolverPath {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FastSettings {
-    /// Time step of every level, s.
+    /// Time step of the levels that resolve the folds of a slowly loaded cloth, s.
     pub dt: f64,
+    /// Time step of a cloth dropped onto props, s: shorter than `dt`, since the folds a
+    /// falling cloth lands in depend on the fall's path, which 64 ms steps damp and change
+    /// (docs/fast-path.md: the tablecloth's coefficient left the exact path's scatter at
+    /// 64 ms and stayed inside it at 16 and 32 ms).
+    pub drop_dt: f64,
     /// Largest edge of the coarsest level as a share of the fabric's bending length
     /// (B/w)^(1/3): coarse enough to be cheap, fine enough that folds, whose width scales
     /// with the bending length, span several elements.
@@ -72,7 +77,7 @@ pub struct FastSettings {
 
 impl Default for FastSettings {
     fn default() -> Self {
-        Self { dt: 0.064, coarsest_edge_share: 0.5, error_share: 0.1 }
+        Self { dt: 0.064, drop_dt: 0.032, coarsest_edge_share: 0.5, error_share: 0.1 }
     }
 }
 
@@ -128,24 +133,27 @@ pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
         // Long steps follow a quasi-static load through near-equilibria, which holds where
         // the mesh resolves the folds. On a mesh whose elements are as wide as the folds the
         // drape depends on the path at the scale of an element, and the scene keeps its step.
-        // A cloth dropped onto a prop takes long steps on any mesh (its folds depend on the
-        // fall's path at every step), with the contact penalty's factor raised with the
-        // square of the step so that its stiffness c·m/Δt² stays the scene's: a vertex
-        // arriving at speed v then stops within v·Δt/√c of the same layer as at the scene's
-        // own step.
+        // A cloth dropped onto a prop takes the shorter `drop_dt` on any mesh (its folds
+        // depend on the fall's path at every step), with the contact penalty's factor raised
+        // with the square of the step so that its stiffness c·m/Δt² stays the scene's: a
+        // vertex arriving at speed v then stops within v·Δt/√c of the same layer as at the
+        // scene's own step.
         let resolved = coarsest_edge(config).is_ok_and(|coarsest| edge <= coarsest * (1.0 + 1e-9));
-        let long = fast.dt > config.solver.dt && (resolved || !quasi_static(config));
-        if long {
-            level.solver.dt = fast.dt;
+        let long_dt = if quasi_static(config) { resolved.then_some(fast.dt) } else { Some(fast.drop_dt) };
+        if let Some(long_dt) = long_dt.filter(|&d| d > config.solver.dt) {
+            level.solver.dt = long_dt;
             if !quasi_static(config) {
-                level.contact.stiffness *= (fast.dt / config.solver.dt).powi(2);
+                level.contact.stiffness *= (long_dt / config.solver.dt).powi(2);
             }
             // The first step after a transfer relaxes, in one long step, what the coarser
             // mesh could not resolve; Newton gets the iterations that takes.
             level.solver.newton.max_iterations = level.solver.newton.max_iterations.max(FAST_MAX_ITERATIONS);
-            // At long steps the incomplete factor leaves CG tens of iterations per Newton
-            // iteration even on coarse meshes; the complete factor a few.
-            if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
+            // On a slowly loaded drape at long steps the incomplete factor leaves CG tens of
+            // iterations per Newton iteration; the complete factor a few, and it is rebuilt
+            // rarely. A falling cloth's contacts and shifts change from one iteration to the
+            // next, and rebuilding the complete factor that often costs more than the
+            // incomplete factor's extra CG iterations (docs/fast-path.md): it keeps `auto`.
+            if quasi_static(config) && level.solver.newton.preconditioner == PreconditionerChoice::Auto {
                 level.solver.newton.preconditioner = PreconditionerChoice::Cholesky;
             }
         }

@@ -138,6 +138,26 @@ fn check_solver(c: &SceneConfig) -> Result<(), Invalid> {
     if n.cg_tolerance >= 1.0 {
         return Err(invalid("solver.newton.cg_tolerance", format!("solver.newton.cg_tolerance = {} must be below 1 (a relative residual; the default is 1e-3)", n.cg_tolerance)));
     }
+    if !(n.error_share.is_finite() && (0.0..1.0).contains(&n.error_share)) {
+        return Err(invalid(
+            "solver.newton.error_share",
+            format!("solver.newton.error_share = {:?} must lie in [0, 1): a share of the step's local error (0: off)", n.error_share),
+        ));
+    }
+    let fast = &solver.fast;
+    positive("solver.fast.dt", fast.dt)?;
+    positive("solver.fast.drop_dt", fast.drop_dt)?;
+    if solver.path == super::levels::SolverPath::Fast {
+        positive_at_most("solver.fast.dt", fast.dt, duration, "scene.duration: the fast path's long step must fit in the run")?;
+        positive_at_most("solver.fast.drop_dt", fast.drop_dt, duration, "scene.duration: a dropped cloth's step must fit in the run")?;
+    }
+    positive("solver.fast.coarsest_edge_share", fast.coarsest_edge_share)?;
+    if !(fast.error_share.is_finite() && (0.0..1.0).contains(&fast.error_share)) {
+        return Err(invalid(
+            "solver.fast.error_share",
+            format!("solver.fast.error_share = {:?} must lie in [0, 1): a share of the step's local error (0: off; default 0.1)", fast.error_share),
+        ));
+    }
     if let Some(a) = solver.adaptive.filter(|a| a.enabled) {
         positive("solver.adaptive.tolerance", a.tolerance)?;
         positive("solver.adaptive.dt_min", a.dt_min)?;
