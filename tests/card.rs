@@ -3,20 +3,13 @@
 //! `rosette run` gives it; the page's size; the contact sheet's size and numbers; bad input
 //! refused with exit 2 before any run.
 
+mod common;
+
+use common::runtime_dir;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn runtime_dir() -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("xdg-runtime");
-    std::fs::create_dir_all(&dir).unwrap();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).unwrap();
-    }
-    dir
-}
 
 fn rosette(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_rosette")).args(args).env("XDG_RUNTIME_DIR", runtime_dir()).output().expect("the rosette binary runs")

@@ -6,6 +6,9 @@
 //!
 //! `ROSETTE_SCREENSHOT_DIR=dir cargo test --test screenshot` also writes the images there.
 
+mod common;
+
+use common::runtime_dir;
 use rosette::render::{self, BACKGROUND, ColorMap, Frame, Headless, RenderOptions, Screenshot};
 use rosette::scene::preset::SCENES;
 use rosette::scene::{Scene, load_scene};
@@ -20,17 +23,6 @@ const SIZE: [u32; 2] = [320, 240];
 /// little enough to keep the test to about a second per scene.
 const STEPS: usize = 20;
 
-/// A private 0700 runtime directory for Mesa (else it warns on every device).
-fn runtime_dir() -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("xdg-runtime");
-    std::fs::create_dir_all(&dir).unwrap();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).unwrap();
-    }
-    dir
-}
 
 /// One device for the whole file: opening lavapipe and compiling the shaders is the slow part.
 fn headless() -> &'static Mutex<Headless> {

@@ -25,3 +25,15 @@ pub fn run_all(preset: &str, sets: Vec<Vec<String>>) -> Vec<(SceneConfig, Metric
         handles.into_iter().map(|h| h.join().unwrap()).collect()
     })
 }
+
+/// A private 0700 runtime directory for Mesa (else it warns on every device).
+pub fn runtime_dir() -> std::path::PathBuf {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("xdg-runtime");
+    std::fs::create_dir_all(&dir).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).unwrap();
+    }
+    dir
+}
