@@ -301,6 +301,13 @@ impl App {
             .map(|d| std::time::Instant::now() + d);
         self.frames += 1;
         if self.options.quit_after_frames.is_some_and(|n| self.frames >= n) {
+            // What a scripted run of the viewer measured: the simulation's pace under the
+            // window's own rendering (the toolbar's figures, once, for logs and CI).
+            let s = &snapshot.stats;
+            println!(
+                "viewer: {} frames; {} simulated {:.3} s in {} steps on {} triangles; last second: {:.2}x real time, {:.1} steps/s",
+                self.frames, snapshot.scene_name, snapshot.time, snapshot.steps, s.triangles, s.real_time_factor, s.steps_per_second
+            );
             event_loop.exit();
             return;
         }
