@@ -313,7 +313,7 @@ impl ViewerUi {
                     .on_hover_text("The validated reference: the scene's own mesh and time step throughout.");
                 ui.selectable_value(&mut path, SolverPath::Fast, "fast").on_hover_text(
                     "Settling scenes settle coarse to fine, with longer steps and Newton solved to the step's own accuracy; \
-                     the drape coefficient stays within the exact path's seed scatter (docs/solvers.md).",
+                     drape coefficients stay within about 0.01 of the exact path's seed scatter (docs/fast-path.md).",
                 );
             });
             if path != snapshot.config.solver.path {
