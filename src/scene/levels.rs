@@ -152,9 +152,10 @@ pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
             // iterations per Newton iteration; the complete factor a few, and it is rebuilt
             // rarely. A falling cloth's contacts and shifts change from one iteration to the
             // next, and rebuilding the complete factor that often costs more than the
-            // incomplete factor's extra CG iterations (docs/fast-path.md): it keeps `auto`.
-            if quasi_static(config) && level.solver.newton.preconditioner == PreconditionerChoice::Auto {
-                level.solver.newton.preconditioner = PreconditionerChoice::Cholesky;
+            // incomplete factor's extra CG iterations (docs/fast-path.md), at any size.
+            if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
+                level.solver.newton.preconditioner =
+                    if quasi_static(config) { PreconditionerChoice::Cholesky } else { PreconditionerChoice::IncompleteCholesky };
             }
         }
         level.solver.newton.error_share = fast.error_share;
