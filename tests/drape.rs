@@ -7,12 +7,8 @@
 mod common;
 
 use common::reference::{bending_rigidity_theta, independent_strip_drape_lower_bound};
-use common::run_all;
-use rosette::scene::{Metrics, SceneConfig};
-
-fn drape_coefficient(m: &Metrics) -> f64 {
-    m.measures.drape().expect("drape measures").drape_coefficient
-}
+use common::{drape_coefficient, run_all};
+use rosette::scene::SceneConfig;
 
 /// Bending length c = (B/w)^(1/3) with B the mean of warp and weft rigidities.
 fn bending_length(c: &SceneConfig) -> f64 {

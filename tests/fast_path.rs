@@ -7,13 +7,9 @@
 
 mod common;
 
-use common::{run, run_all};
+use common::{drape_coefficient, run, run_all};
 use rosette::scene::levels::schedule;
 use rosette::scene::{Metrics, Scene, load_scene};
-
-fn drape_coefficient(m: &Metrics) -> f64 {
-    m.measures.drape().expect("drape measures").drape_coefficient
-}
 
 /// Issue 23's criterion: over the same seeds, the fast path's coefficients lie within 0.02
 /// of the exact path's range on the same mesh.

@@ -139,10 +139,11 @@ pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
         // vertex arriving at speed v then stops within v·Δt/√c of the same layer as at the
         // scene's own step.
         let resolved = coarsest_edge(config).is_ok_and(|coarsest| edge <= coarsest * (1.0 + 1e-9));
-        let long_dt = if quasi_static(config) { resolved.then_some(fast.dt) } else { Some(fast.drop_dt) };
+        let slow = quasi_static(config);
+        let long_dt = if slow { resolved.then_some(fast.dt) } else { Some(fast.drop_dt) };
         if let Some(long_dt) = long_dt.filter(|&d| d > config.solver.dt) {
             level.solver.dt = long_dt;
-            if !quasi_static(config) {
+            if !slow {
                 level.contact.stiffness *= (long_dt / config.solver.dt).powi(2);
             }
             // The first step after a transfer relaxes, in one long step, what the coarser
@@ -155,7 +156,7 @@ pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
             // incomplete factor's extra CG iterations (docs/fast-path.md), at any size.
             if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
                 level.solver.newton.preconditioner =
-                    if quasi_static(config) { PreconditionerChoice::Cholesky } else { PreconditionerChoice::IncompleteCholesky };
+                    if slow { PreconditionerChoice::Cholesky } else { PreconditionerChoice::IncompleteCholesky };
             }
         }
         level.solver.newton.error_share = fast.error_share;

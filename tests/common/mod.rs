@@ -18,6 +18,11 @@ pub fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Metrics) {
     (config, metrics)
 }
 
+/// The drape coefficient of a drape scene's run.
+pub fn drape_coefficient(m: &Metrics) -> f64 {
+    m.measures.drape().expect("drape measures").drape_coefficient
+}
+
 /// Runs `preset` for several override sets, one thread each (both cores).
 pub fn run_all(preset: &str, sets: Vec<Vec<String>>) -> Vec<(SceneConfig, Metrics)> {
     std::thread::scope(|s| {
