@@ -192,9 +192,9 @@ impl CardView {
         ui.strong(&c.fabric.name);
         egui::Grid::new("card_numbers").num_columns(4).striped(true).show(ui, |ui| {
             ui.label("drape coefficient");
-            ui.monospace(format!("{:.3}", c.drape.drape_coefficient));
+            ui.monospace(format!("{:.3}", c.drape.result.drape_coefficient));
             ui.label("nodes");
-            ui.monospace(c.drape.nodes.to_string());
+            ui.monospace(c.drape.result.nodes.to_string());
             ui.end_row();
             for (t, b) in c.cantilever.iter().zip(&c.pure_bending) {
                 ui.label(format!("bending length, {}", t.direction));

@@ -4,9 +4,9 @@
 
 use super::picture::{self, THREE_QUARTER, blit, placeholder};
 use super::suite::parallel_map;
-use super::{CardError, Progress};
+use super::{CardError, DrapeResult, Progress};
 use crate::render::Headless;
-use crate::scene::{Metrics, RunOptions, Scene, SceneConfig, SceneKind, load_scene, run_scene};
+use crate::scene::{RunOptions, Scene, SceneConfig, SceneKind, load_scene, run_scene};
 use glam::DVec3;
 use image::RgbaImage;
 use plotters::prelude::*;
@@ -29,16 +29,8 @@ pub struct Entry {
     pub fabric: String,
     /// Its `name`.
     pub name: String,
-    pub drape_coefficient: f64,
-    pub nodes: usize,
-    pub outline_radius_min_mm: f64,
-    pub outline_radius_max_mm: f64,
-    pub settled: bool,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub settle_time_s: Option<f64>,
-    pub simulated_s: f64,
-    /// Whether every Newton solve converged.
-    pub converged: bool,
+    #[serde(flatten)]
+    pub result: DrapeResult,
     /// The run's wall time on its thread, s (the runs share the cores).
     pub wall_seconds: f64,
     /// Why the run failed, if it did (it then has no numbers).
@@ -73,13 +65,13 @@ impl Comparison {
                 "{},{},{},{},{},{},{},{},{},{}\n",
                 quote(&e.fabric),
                 quote(&e.name),
-                e.drape_coefficient,
-                e.nodes,
-                e.outline_radius_min_mm,
-                e.outline_radius_max_mm,
-                e.settled,
-                e.settle_time_s.map_or(String::new(), |t| t.to_string()),
-                e.converged,
+                e.result.drape_coefficient,
+                e.result.nodes,
+                e.result.outline_radius_min_mm,
+                e.result.outline_radius_max_mm,
+                e.result.settled,
+                e.result.settle_time_s.map_or(String::new(), |t| t.to_string()),
+                e.result.converged,
                 quote(e.error.as_deref().unwrap_or(""))
             );
         }
@@ -130,7 +122,7 @@ pub fn run(fabrics: &[String], configs: Vec<SceneConfig>, progress: &Progress) -
         entry.wall_seconds = started.elapsed().as_secs_f64();
         match outcome {
             Ok((scene, metrics)) => {
-                fill(&mut entry, &metrics);
+                entry.result = DrapeResult::from_metrics(&metrics);
                 (entry, Some(scene))
             }
             Err(e) => {
@@ -141,18 +133,6 @@ pub fn run(fabrics: &[String], configs: Vec<SceneConfig>, progress: &Progress) -
     })
 }
 
-fn fill(entry: &mut Entry, metrics: &Metrics) {
-    if let Some(d) = metrics.measures.drape() {
-        entry.drape_coefficient = d.drape_coefficient;
-        entry.nodes = d.nodes;
-        entry.outline_radius_min_mm = 1e3 * d.outline_radius_min.unwrap_or(f64::NAN);
-        entry.outline_radius_max_mm = 1e3 * d.outline_radius_max;
-    }
-    entry.settled = metrics.settled.unwrap_or(false);
-    entry.settle_time_s = metrics.settle_time;
-    entry.simulated_s = metrics.simulated_seconds;
-    entry.converged = metrics.converged;
-}
 
 /// Renders every settled drape with one camera, framed on all of them together, so that
 /// the pictures compare at one scale. A run that failed gets a note instead.
@@ -207,11 +187,11 @@ pub fn contact_sheet(comparison: &Comparison, pictures: &[RgbaImage]) -> Result<
             let (line, style) = match &e.error {
                 Some(error) => (picture::wrap(&format!("failed: {error}"), 52)[0].clone(), &bad),
                 None => {
-                    let rest = match (e.settled, e.settle_time_s) {
+                    let rest = match (e.result.settled, e.result.settle_time_s) {
                         (true, Some(t)) => format!("settled at {t:.2} s"),
-                        _ => format!("not settled ({:.2} s)", e.simulated_s),
+                        _ => format!("not settled ({:.2} s)", e.result.simulated_s),
                     };
-                    (format!("DC {:.3}   {} nodes   {rest}", e.drape_coefficient, e.nodes), &small)
+                    (format!("DC {:.3}   {} nodes   {rest}", e.result.drape_coefficient, e.result.nodes), &small)
                 }
             };
             root.draw_text(&line, style, (x, y + 24)).map_err(|e| e.to_string())?;

@@ -203,6 +203,18 @@ pub struct Drape {
     pub scene: String,
     pub specimen_diameter_mm: f64,
     pub support_diameter_mm: f64,
+    #[serde(flatten)]
+    pub result: DrapeResult,
+    pub vertices: usize,
+    pub triangles: usize,
+    pub edge_length_mm: f64,
+    /// The shadow's outline: angle (°) against radius from the support's centre (mm).
+    pub outline: Curve,
+}
+
+/// What a drape run came to, as the card and `rosette compare` both report it.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct DrapeResult {
     /// (A_shadow − A_support)/(A_specimen − A_support).
     pub drape_coefficient: f64,
     pub nodes: usize,
@@ -211,16 +223,32 @@ pub struct Drape {
     /// Whether the cloth came to rest (RMS speed below the scene's settle speed).
     pub settled: bool,
     /// Simulated time at which it settled, s.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settle_time_s: Option<f64>,
     pub simulated_s: f64,
     /// Whether every Newton solve converged.
     pub converged: bool,
-    pub vertices: usize,
-    pub triangles: usize,
-    pub edge_length_mm: f64,
-    /// The shadow's outline: angle (°) against radius from the support's centre (mm).
-    pub outline: Curve,
+}
+
+impl DrapeResult {
+    /// From a run's metrics; the drape's own numbers stay zero where the run has no drape
+    /// measures.
+    pub fn from_metrics(metrics: &crate::scene::Metrics) -> Self {
+        let mut result = Self {
+            settled: metrics.settled.unwrap_or(false),
+            settle_time_s: metrics.settle_time,
+            simulated_s: metrics.simulated_seconds,
+            converged: metrics.converged,
+            ..Self::default()
+        };
+        if let Some(d) = metrics.measures.drape() {
+            result.drape_coefficient = d.drape_coefficient;
+            result.nodes = d.nodes;
+            result.outline_radius_min_mm = 1e3 * d.outline_radius_min.unwrap_or(f64::NAN);
+            result.outline_radius_max_mm = 1e3 * d.outline_radius_max;
+        }
+        result
+    }
 }
 
 /// One sheet value read back by a virtual test (fabrics made from sheets).

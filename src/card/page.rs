@@ -64,7 +64,7 @@ pub fn draw(card: &Card, pictures: Result<&[RgbaImage; 2], &str>) -> Result<Vec<
         curve_panel(&shear_area, "Shear (KES-FB1, 20 cm × 5 cm)", &line, &s.curve, &input, "G·γ").map_err(|e| e.to_string())?;
         let d = &card.drape;
         let captions = [
-            format!("From above: DC {:.3}, {} nodes", d.drape_coefficient, d.nodes),
+            format!("From above: DC {:.3}, {} nodes", d.result.drape_coefficient, d.result.nodes),
             format!("From the side: {:.0} mm disc on a {:.0} mm support", d.specimen_diameter_mm, d.support_diameter_mm),
         ];
         for (area, caption) in [above_area, side_area].iter().zip(captions) {
@@ -201,21 +201,21 @@ fn tables(area: &Area, card: &Card) -> DrawResult {
     let d = &card.drape;
     let mut t = Table { area: &columns[2], y: 8 };
     t.heading(&format!("Cusick drape ({})", d.scene))?;
-    let settled = match (d.settled, d.settle_time_s) {
+    let settled = match (d.result.settled, d.result.settle_time_s) {
         (true, Some(s)) => format!("settled at {s:.2} s"),
-        _ => format!("not settled after {:.2} s", d.simulated_s),
+        _ => format!("not settled after {:.2} s", d.result.simulated_s),
     };
     let lines = [
-        format!("drape coefficient DC  {:.3}", d.drape_coefficient),
-        format!("nodes  {}", d.nodes),
-        format!("shadow radius  {:.1} to {:.1} mm", d.outline_radius_min_mm, d.outline_radius_max_mm),
+        format!("drape coefficient DC  {:.3}", d.result.drape_coefficient),
+        format!("nodes  {}", d.result.nodes),
+        format!("shadow radius  {:.1} to {:.1} mm", d.result.outline_radius_min_mm, d.result.outline_radius_max_mm),
         settled,
         format!("mesh  {} triangles, {:.1} mm edges", d.triangles, d.edge_length_mm),
     ];
     for line in lines {
         t.row(&[(0, line)], &small)?;
     }
-    if !d.converged {
+    if !d.result.converged {
         t.row(&[(0, "some Newton solves did not converge".into())], &font(13).color(&BAD))?;
     }
     t.y += 6;

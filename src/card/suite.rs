@@ -1,7 +1,7 @@
 //! Running the card's tests: every test of the suite as one job on rayon's pool, the drape
 //! first (it is the longest), then the card's numbers from their results.
 
-use super::{Bending, Cantilever, Card, CardError, Cost, Curve, Drape, FabricInfo, Progress, Shear, SheetValue, Tensile};
+use super::{Bending, Cantilever, Card, CardError, Cost, Curve, Drape, DrapeResult, FabricInfo, Progress, Shear, SheetValue, Tensile};
 use crate::fabric::import::{Import, KES_FM};
 use crate::fabric::sheet::Sheets;
 use crate::fabric::units::GF_CM_PER_CM;
@@ -347,7 +347,9 @@ fn first_run<T>(previous: Option<T>) {
 
 /// The drape's numbers from its run.
 fn drape_numbers(scene: &Scene, metrics: &Metrics) -> Result<Drape, CardError> {
-    let d = metrics.measures.drape().ok_or_else(|| CardError::Drape("the scene reported no drape measures".into()))?;
+    if metrics.measures.drape().is_none() {
+        return Err(CardError::Drape("the scene reported no drape measures".into()));
+    }
     let outline = scene.rig.outline(&scene.model, &scene.state).unwrap_or_default();
     let step = (outline.len() / OUTLINE_POINTS).max(1);
     let c = &scene.config;
@@ -355,14 +357,7 @@ fn drape_numbers(scene: &Scene, metrics: &Metrics) -> Result<Drape, CardError> {
         scene: DRAPE_SCENE.into(),
         specimen_diameter_mm: 1e3 * c.cloth.diameter,
         support_diameter_mm: 1e3 * c.test.support_diameter.unwrap_or(0.0),
-        drape_coefficient: d.drape_coefficient,
-        nodes: d.nodes,
-        outline_radius_min_mm: 1e3 * d.outline_radius_min.unwrap_or(f64::NAN),
-        outline_radius_max_mm: 1e3 * d.outline_radius_max,
-        settled: metrics.settled.unwrap_or(false),
-        settle_time_s: metrics.settle_time,
-        simulated_s: metrics.simulated_seconds,
-        converged: metrics.converged,
+        result: DrapeResult::from_metrics(metrics),
         vertices: metrics.vertices,
         triangles: metrics.triangles,
         edge_length_mm: 1e3 * c.mesh.edge_length,

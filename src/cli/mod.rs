@@ -69,7 +69,7 @@ pub fn card(spec: &str, out: &std::path::Path) -> ExitCode {
     let c = &made.card;
     eprintln!(
         "{stem}: DC {:.3}, {} nodes; bending length warp {:.1} mm, weft {:.1} mm; {:.1} CPU s, {:.1} s wall",
-        c.drape.drape_coefficient, c.drape.nodes, c.cantilever[0].bending_length_mm, c.cantilever[1].bending_length_mm, c.cost.cpu_seconds, c.cost.wall_seconds
+        c.drape.result.drape_coefficient, c.drape.result.nodes, c.cantilever[0].bending_length_mm, c.cantilever[1].bending_length_mm, c.cost.cpu_seconds, c.cost.wall_seconds
     );
     match written {
         Ok(paths) => paths.iter().for_each(|p| eprintln!("wrote {}", p.display())),
@@ -117,7 +117,7 @@ pub fn compare(fabrics: &[String], scene: &str, overrides: &[String], out: &std:
     };
     for e in &comparison.entries {
         match &e.error {
-            None => eprintln!("{:<20} DC {:.3}  {} nodes", e.fabric, e.drape_coefficient, e.nodes),
+            None => eprintln!("{:<20} DC {:.3}  {} nodes", e.fabric, e.result.drape_coefficient, e.result.nodes),
             Some(error) => eprintln!("{:<20} failed: {error}", e.fabric),
         }
     }
