@@ -128,7 +128,7 @@ fn check_solver(c: &SceneConfig) -> Result<(), Invalid> {
     }
     let n = &solver.newton;
     if n.max_iterations == 0 {
-        return Err(invalid("solver.newton.max_iterations", "solver.newton.max_iterations must be at least 1 (default 30): with none, no step is solved".into()));
+        return Err(invalid("solver.newton.max_iterations", format!("solver.newton.max_iterations must be at least 1 (default {}): with none, no step is solved", crate::sim::solver::DEFAULT_MAX_ITERATIONS)));
     }
     if n.cg_max_iterations == 0 {
         return Err(invalid("solver.newton.cg_max_iterations", "solver.newton.cg_max_iterations must be at least 1 (default 3000): with none, Newton has no direction".into()));

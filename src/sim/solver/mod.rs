@@ -24,7 +24,7 @@ mod report;
 mod settings;
 
 pub use report::{StepError, StepReport, StepTimings, UNCONVERGED_FACTOR};
-pub use settings::{AdaptiveStep, Indefinite, NewtonSettings, PreconditionerChoice};
+pub use settings::{AdaptiveStep, DEFAULT_MAX_ITERATIONS, Indefinite, NewtonSettings, PreconditionerChoice};
 
 use crate::sim::contact::{ContactModel, ContactStats, NearPairs};
 use crate::sim::linalg::DirectPattern;
