@@ -133,7 +133,6 @@ pub fn run(fabrics: &[String], configs: Vec<SceneConfig>, progress: &Progress) -
     })
 }
 
-
 /// Renders every settled drape with one camera, framed on all of them together, so that
 /// the pictures compare at one scale. A run that failed gets a note instead.
 pub fn pictures(scenes: &[Option<&Scene>]) -> Result<Vec<RgbaImage>, String> {
