@@ -472,6 +472,28 @@ mod tests {
         assert!(total > 100, "the falling layer should come within reach of the lower one: {total}");
     }
 
+    /// Two layers in contact, 1 mm apart within a 2 mm layer: the upper one sliding 5 mm
+    /// along them may take the whole step (it crosses nothing), where the bound on how
+    /// fast each pair can close would hold it to 0.9 · 1/5 of it; moving 5 mm down through
+    /// the lower one it stops at nine tenths of the way to the crossing, a fifth of the step.
+    #[test]
+    fn a_sliding_layer_takes_its_whole_step_and_a_crossing_one_stops_short() {
+        let mesh = Mesh::rectangle(0.04, 0.02, 0.004, Pattern::Regular, 0).unwrap();
+        let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
+        let settings = ContactSettings { self_collision: true, self_thickness: Some(0.002), relative_motion: true, ..Default::default() };
+        let contact = ContactModel::new(Vec::new(), settings).unwrap();
+        let upper = |p: DVec2| p.x > 0.02;
+        let start: Vec<DVec3> = model.rest.iter().map(|&p| if upper(p) { DVec3::new(0.04 - p.x, p.y, 0.001) } else { DVec3::new(p.x, p.y, 0.0) }).collect();
+        for (motion, expected) in [(DVec3::new(0.0, 0.005, 0.0), 1.0), (DVec3::new(0.0, 0.0, -0.005), 0.9 * 0.2)] {
+            let d: Vec<DVec3> = model.rest.iter().map(|&p| if upper(p) { motion } else { DVec3::ZERO }).collect();
+            let predicted: Vec<DVec3> = start.iter().zip(&d).map(|(x, d)| *x + *d).collect();
+            let contacts = contact.begin_step(model.cloth(), &mut NearPairs::default(), &start, &predicted, 0.004);
+            assert!(contacts.pair_count() > 100, "the layers are in contact: {} pairs", contacts.pair_count());
+            let limit = contacts.max_step(&start, &d);
+            assert!((limit - expected).abs() < 1e-6, "moving by {motion}: step limited to {limit}, expected {expected}");
+        }
+    }
+
     /// The same on a mesh of over `PARALLEL_TRIANGLES` triangles, whose searches run in
     /// chunks on rayon's threads.
     #[test]
