@@ -453,22 +453,9 @@ mod tests {
     /// vertices' paths. They must still be exactly those an exhaustive search gives.
     #[test]
     fn a_landing_cloth_misses_no_pair_along_its_paths() {
-        let mesh = Mesh::rectangle(0.04, 0.02, 0.002, Pattern::Regular, 0).unwrap();
-        let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
-        let settings = ContactSettings { self_collision: true, self_thickness: Some(0.002), relative_motion: true, ..Default::default() };
-        let contact = ContactModel::new(Vec::new(), settings).unwrap();
+        let (model, contact) = strip(0.002, true);
         let at = |p: DVec2, t: f64| if p.x <= 0.02 { DVec3::new(p.x, p.y, 0.0) } else { DVec3::new(0.04 - p.x, p.y, 0.035 - 0.01 * t) };
-        let (mut near, mut total) = (NearPairs::default(), 0);
-        for step in 0..5 {
-            let t = step as f64;
-            let start: Vec<DVec3> = model.rest.iter().map(|&p| at(p, t)).collect();
-            let predicted: Vec<DVec3> = model.rest.iter().map(|&p| at(p, t + 1.0)).collect();
-            let contacts = contact.begin_step(model.cloth(), &mut near, &start, &predicted, 0.004);
-            let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
-            assert_eq!(listed.len(), contacts.pairs.len(), "step {step}: a pair listed twice");
-            assert_eq!(listed, all_pairs(&model, &start, &predicted, 0.002, true), "step {step}");
-            total += listed.len();
-        }
+        let total = pairs_over_steps(&model, &contact, 5, true, at);
         assert!(total > 100, "the falling layer should come within reach of the lower one: {total}");
     }
 
@@ -478,10 +465,7 @@ mod tests {
     /// the lower one it stops at nine tenths of the way to the crossing, a fifth of the step.
     #[test]
     fn a_sliding_layer_takes_its_whole_step_and_a_crossing_one_stops_short() {
-        let mesh = Mesh::rectangle(0.04, 0.02, 0.004, Pattern::Regular, 0).unwrap();
-        let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
-        let settings = ContactSettings { self_collision: true, self_thickness: Some(0.002), relative_motion: true, ..Default::default() };
-        let contact = ContactModel::new(Vec::new(), settings).unwrap();
+        let (model, contact) = strip(0.004, true);
         let upper = |p: DVec2| p.x > 0.02;
         let start: Vec<DVec3> = model.rest.iter().map(|&p| if upper(p) { DVec3::new(0.04 - p.x, p.y, 0.001) } else { DVec3::new(p.x, p.y, 0.0) }).collect();
         for (motion, expected) in [(DVec3::new(0.0, 0.005, 0.0), 1.0), (DVec3::new(0.0, 0.0, -0.005), 0.9 * 0.2)] {
@@ -506,28 +490,38 @@ mod tests {
     /// step, with the closing bound centred where `relative`, checked against the exhaustive
     /// search; returns how many there were.
     fn folded_strip_pairs(edge: f64, steps: usize, relative: bool, fall: f64) -> usize {
-        let mesh = Mesh::rectangle(0.04, 0.02, edge, Pattern::Regular, 0).unwrap();
-        let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
+        let (model, contact) = strip(edge, relative);
         assert_eq!(model.triangles.len() >= PARALLEL_TRIANGLES, edge < 0.001, "{} triangles", model.triangles.len());
-        let settings = ContactSettings { self_collision: true, self_thickness: Some(0.002), relative_motion: relative, ..Default::default() };
-        let contact = ContactModel::new(Vec::new(), settings).unwrap();
         let folded = |p: DVec2, drift: DVec3| {
             // The layers drift apart in opposite directions, as closing pairs would.
             if p.x <= 0.02 { DVec3::new(p.x, p.y, 0.0) - drift * (0.02 - p.x) / 0.02 } else { DVec3::new(0.04 - p.x, p.y, 0.0015) + drift * (p.x - 0.02) / 0.02 }
         };
-        let mut total = 0;
-        let mut near = NearPairs::default();
+        // Both layers also fall together, `fall` m a step.
+        let drift = |t: f64| DVec3::new(0.0015 * t, 0.001 * (0.7 * t).sin(), -0.0001 * t);
+        pairs_over_steps(&model, &contact, steps, relative, |p, t| folded(p, drift(t)) - DVec3::Z * (fall * t))
+    }
+
+    /// A 4 × 2 cm strip meshed at `edge` with self-collision in a 2 mm layer, bounds on the
+    /// pairs' closing centred where `relative`.
+    fn strip(edge: f64, relative: bool) -> (Model, ContactModel) {
+        let mesh = Mesh::rectangle(0.04, 0.02, edge, Pattern::Regular, 0).unwrap();
+        let model = Model::new(&mesh, &test_fabric(), 0.0, PhysicsOptions::default()).unwrap();
+        let settings = ContactSettings { self_collision: true, self_thickness: Some(0.002), relative_motion: relative, ..Default::default() };
+        (model, ContactModel::new(Vec::new(), settings).unwrap())
+    }
+
+    /// Pairs over `steps` steps of the cloth at `at(rest position, step)`, each step's list
+    /// (the near-pair list kept across them) checked against the exhaustive search.
+    fn pairs_over_steps(model: &Model, contact: &ContactModel, steps: usize, relative: bool, at: impl Fn(DVec2, f64) -> DVec3) -> usize {
+        let (mut near, mut total) = (NearPairs::default(), 0);
         for step in 0..steps {
             let t = step as f64;
-            // Both layers also fall together, `fall` m a step.
-            let drift = |t: f64| DVec3::new(0.0015 * t, 0.001 * (0.7 * t).sin(), -0.0001 * t);
-            let folded = |p: DVec2, t: f64| folded(p, drift(t)) - DVec3::Z * (fall * t);
-            let start: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, t)).collect();
-            let predicted: Vec<DVec3> = model.rest.iter().map(|&p| folded(p, t + 1.0)).collect();
+            let start: Vec<DVec3> = model.rest.iter().map(|&p| at(p, t)).collect();
+            let predicted: Vec<DVec3> = model.rest.iter().map(|&p| at(p, t + 1.0)).collect();
             let contacts = contact.begin_step(model.cloth(), &mut near, &start, &predicted, 0.004);
             let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
             assert_eq!(listed.len(), contacts.pairs.len(), "step {step}: a pair listed twice");
-            assert_eq!(listed, all_pairs(&model, &start, &predicted, 0.002, relative), "step {step}");
+            assert_eq!(listed, all_pairs(model, &start, &predicted, 0.002, relative), "step {step}");
             total += listed.len();
         }
         total
