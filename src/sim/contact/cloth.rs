@@ -150,10 +150,10 @@ impl ContactModel {
         let relative = self.settings.relative_motion;
         let motion: Vec<DVec3> = start.iter().zip(predicted).map(|(a, b)| *b - *a).collect();
         // With centred bounds a pair is also kept only where its predicted paths' boxes come
-        // within reach, with half an edge's allowance for the solve's departure from them:
-        // the centred bound takes no account of direction, and lists a landed vertex with a
-        // falling one beside it that cannot meet it.
-        let allowance = 0.5 * cloth.mean_edge_length;
+        // within reach, with the skin's half edge as allowance for the solve's departure
+        // from them: the centred bound takes no account of direction, and lists a landed
+        // vertex with a falling one beside it that cannot meet it.
+        let allowance = skin(cloth);
         let path = |i: usize| (start[i].min(predicted[i]), start[i].max(predicted[i]));
         let paths = |vertices: &[usize]| vertices.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| (lo.min(path(i).0), hi.max(path(i).1)));
         let paths_meet = |one: &[usize], other: &[usize]| !relative || boxes_overlap(paths(one), paths(other), delta + allowance);

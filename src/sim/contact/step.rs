@@ -188,7 +188,7 @@ impl StepContacts {
                     // bound would cut the step, the pair's own path along d decides: up to
                     // nine tenths of the way to where it would cross, all of d if it
                     // does not.
-                    limit = limit.max(0.9 * self.crossing_time(p, y, d).unwrap_or(1.0 / 0.9));
+                    limit = limit.max(0.9 * crossing_time(p, gap, y, d).unwrap_or(1.0 / 0.9));
                 }
                 alpha = alpha.min(limit);
             }
@@ -196,14 +196,7 @@ impl StepContacts {
         alpha.max(0.0)
     }
 
-    /// The earliest fraction of `d` from `y` at which pair `p` would cross (meet within a
-    /// thousandth of its present gap), if it does within the whole of d.
-    fn crossing_time(&self, p: &SelfPair, y: &[DVec3], d: &[DVec3]) -> Option<f64> {
-        let path = |i: u32| [y[i as usize], y[i as usize] + d[i as usize]];
-        let [a, b, c, e] = p.vertices.map(path);
-        let eps = 1e-3 * self.self_distance(p, y).0;
-        if p.edge_edge { edge_edge_ccd(a, b, c, e, eps) } else { vertex_triangle_ccd(a, b, c, e, eps) }
-    }
+
 
     /// The rank-one Gauss–Newton terms of the active cloth–cloth pairs at `y`.
     pub fn couplings(&self, y: &[DVec3], out: &mut Vec<Coupling>) {
@@ -223,4 +216,12 @@ impl StepContacts {
 
 fn outer(a: DVec3, b: DVec3) -> DMat3 {
     DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+}
+
+/// The earliest fraction of `d` from `y` at which pair `p`, `gap` apart, would cross (meet
+/// within a thousandth of that gap), if it does within the whole of d.
+fn crossing_time(p: &SelfPair, gap: f64, y: &[DVec3], d: &[DVec3]) -> Option<f64> {
+    let path = |i: u32| [y[i as usize], y[i as usize] + d[i as usize]];
+    let [a, b, c, e] = p.vertices.map(path);
+    if p.edge_edge { edge_edge_ccd(a, b, c, e, 1e-3 * gap) } else { vertex_triangle_ccd(a, b, c, e, 1e-3 * gap) }
 }
