@@ -5,11 +5,8 @@ use super::system::SystemMatrix;
 use glam::{DMat3, DVec3, Mat3};
 
 /// Block incomplete LDLᵀ factor of the system matrix, A ≈ (D + U) D⁻¹ (D + U)ᵀ with U
-/// strictly lower and D block diagonal, both in 3×3 blocks, on the pattern of the whole
-/// matrix: the in-plane one-ring and the bending matrix's wider stencil. Leaving the
-/// bending entries out (as a factor on the in-plane pattern does) costs little on coarse
-/// meshes but makes the conjugate gradient's iterations grow like the bending stiffness,
-/// h²·B/ℓ⁴, as the mesh is refined.
+/// strictly lower and D block diagonal, both in 3×3 blocks, on one of two patterns
+/// ([`FactorPattern`]).
 ///
 /// Triangular solves are sequential, so a large matrix is factored in parts: contiguous
 /// ranges of vertices (spatially coherent on our meshes) whose couplings to other parts
@@ -21,9 +18,32 @@ use glam::{DMat3, DVec3, Mat3};
 /// use takes 3×3 blocks on a fixed pattern.
 pub struct IncompleteCholesky {
     parts: Vec<FactorPart>,
+    pub pattern: FactorPattern,
+    /// Multiply-adds of one conjugate-gradient iteration with it: the matrix product and
+    /// the two triangular solves.
+    pub iteration_cost: f64,
     /// What building it cost, in conjugate-gradient iterations with it (from counts of
     /// multiply-adds, so the same on every machine).
     pub cost_in_iterations: f64,
+}
+
+/// Which blocks an incomplete factor keeps. Neither is cheaper everywhere, so the solver
+/// measures both as it goes (`solver::preconditioning::PatternChoice`); docs/performance-log.md
+/// has the figures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FactorPattern {
+    /// The whole matrix's pattern: the in-plane one-ring and the bending matrix's wider
+    /// stencil (each triangle's bending couples the vertices of its three neighbours: about
+    /// 45 columns a row on a regular mesh). Where bending sets the slow modes (a drape's
+    /// skirt at 4 ms steps) a factor without those entries leaves CG iterations growing like
+    /// the bending stiffness h²·B/ℓ⁴ as the mesh is refined: eight times as many on the
+    /// 7.5 mm drape.
+    Wide,
+    /// The in-plane one-ring and the contact couplings only (about 7 columns a row), so a
+    /// solve with it reads an eighth of the blocks. Where inertia, membrane and contact
+    /// set the slow modes (a cloth landing on a prop at 16 ms steps) CG needs only a few
+    /// more iterations with it than with the wide one.
+    Ring,
 }
 
 /// Vertices per part of a split factor: below twice this a factor is one part.
@@ -51,8 +71,9 @@ impl IncompleteCholesky {
         self.parts.len()
     }
 
-    /// Factors A + shift·diag(A); None if a pivot block is not positive definite (breakdown).
-    pub(super) fn new(a: &SystemMatrix, shift: f64) -> Option<Self> {
+    /// Factors A + shift·diag(A) on `pattern`; None if a pivot block is not positive
+    /// definite (breakdown).
+    pub(super) fn new(a: &SystemMatrix, shift: f64, pattern: FactorPattern) -> Option<Self> {
         use rayon::prelude::*;
         let n = a.fixed.len();
         let count = if n < 2 * PART_VERTICES { 1 } else { n / PART_VERTICES };
@@ -84,9 +105,9 @@ impl IncompleteCholesky {
             });
         }
         let parts = if count == 1 {
-            vec![FactorPart::new(a, &coupled, shift, 0, n)?]
+            vec![FactorPart::new(a, &coupled, shift, pattern, 0, n)?]
         } else {
-            bounds.par_iter().map(|&(lo, hi)| FactorPart::new(a, &coupled, shift, lo, hi)).collect::<Option<Vec<_>>>()?
+            bounds.par_iter().map(|&(lo, hi)| FactorPart::new(a, &coupled, shift, pattern, lo, hi)).collect::<Option<Vec<_>>>()?
         };
         // A block product is 27 multiply-adds; a CG iteration applies every factor block
         // twice and the matrix once (9 per block, 3 per bending entry).
@@ -94,7 +115,7 @@ impl IncompleteCholesky {
         let factor_blocks: usize = parts.iter().map(|p| p.lower.len() + p.pivot_inverse.len()).sum();
         let per_iteration = 18 * factor_blocks + 9 * a.stiffness.values.len() + 3 * a.bending.map_or(0, |q| q.values.len());
         let cost_in_iterations = 27.0 * products as f64 / per_iteration.max(1) as f64;
-        Some(Self { parts, cost_in_iterations })
+        Some(Self { parts, pattern, iteration_cost: per_iteration as f64, cost_in_iterations })
     }
 
     /// z = P⁻¹ r, each part on its own.
@@ -119,9 +140,9 @@ impl IncompleteCholesky {
 }
 
 impl FactorPart {
-    /// Factors rows and columns `lo..hi` of A + shift·diag(A), with the contact couplings'
-    /// lower blocks `coupled` by row.
-    fn new(a: &SystemMatrix, coupled: &[Vec<(u32, DMat3)>], shift: f64, lo: usize, hi: usize) -> Option<Self> {
+    /// Factors rows and columns `lo..hi` of A + shift·diag(A) on `pattern`, with the
+    /// contact couplings' lower blocks `coupled` by row.
+    fn new(a: &SystemMatrix, coupled: &[Vec<(u32, DMat3)>], shift: f64, pattern: FactorPattern, lo: usize, hi: usize) -> Option<Self> {
         let k = a.stiffness;
         let rows = hi - lo;
         let mut row_start = Vec::with_capacity(rows + 1);
@@ -142,6 +163,11 @@ impl FactorPart {
                 // The strictly lower part within this factor's rows, fixed vertices left out.
                 let keep = |col: u32| (lo..row).contains(&(col as usize)) && !a.fixed[col as usize];
                 merge_rows(k.row_pattern(row), q_row, keep, &mut merged);
+                if pattern == FactorPattern::Ring {
+                    // Bending entries outside the one-ring are dropped (not lumped onto the
+                    // diagonal: that measured no better).
+                    merged.retain(|&(_, k_slot, _)| k_slot != usize::MAX);
+                }
                 let mut push = |col: u32, block: DMat3| {
                     position[col as usize - lo] = cols.len();
                     cols.push(col);

@@ -18,7 +18,7 @@ mod tests;
 
 pub use cg::{CgReport, pcg};
 pub use direct::{DirectFactor, DirectPattern};
-pub use incomplete::IncompleteCholesky;
+pub use incomplete::{FactorPattern, IncompleteCholesky};
 pub use multigrid::Multigrid;
 pub use preconditioner::Preconditioner;
 pub use storage::{BlockCsr, ScalarCsr};

@@ -4,7 +4,7 @@
 //! one place that names them all, so the factors never import each other.
 
 use super::direct::DirectFactor;
-use super::incomplete::IncompleteCholesky;
+use super::incomplete::{FactorPattern, IncompleteCholesky};
 use super::multigrid::Multigrid;
 use super::system::SystemMatrix;
 use glam::{DMat3, DVec3};
@@ -45,11 +45,11 @@ impl Preconditioner {
 }
 
 impl SystemMatrix<'_> {
-    /// The preconditioner: block incomplete Cholesky on the matrix's pattern, or block Jacobi if
-    /// that factorisation breaks down even with a diagonal shift.
-    pub fn preconditioner(&self) -> Preconditioner {
+    /// The preconditioner: block incomplete Cholesky on `pattern`, or block Jacobi if that
+    /// factorisation breaks down even with a diagonal shift.
+    pub fn preconditioner(&self, pattern: FactorPattern) -> Preconditioner {
         for shift in [0.0, 1e-3, 1e-2, 1e-1] {
-            if let Some(factor) = IncompleteCholesky::new(self, shift) {
+            if let Some(factor) = IncompleteCholesky::new(self, shift, pattern) {
                 return Preconditioner::IncompleteCholesky(factor);
             }
         }

@@ -30,7 +30,7 @@ use crate::sim::contact::{ContactModel, ContactStats, NearPairs};
 use crate::sim::linalg::DirectPattern;
 use crate::sim::model::Model;
 use glam::DVec3;
-use preconditioning::CachedPreconditioner;
+use preconditioning::{CachedPreconditioner, PatternChoice};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -121,6 +121,8 @@ pub struct Integrator {
     forces: Vec<DVec3>,
     /// The linear solves' preconditioner, kept from step to step while it stays good.
     preconditioner: Option<CachedPreconditioner>,
+    /// The pattern of the incomplete factors, chosen by what each has cost so far.
+    incomplete_pattern: PatternChoice,
     /// Ordering and symbolic factor for complete Cholesky factors, made once per model.
     direct_pattern: Option<Arc<DirectPattern>>,
     /// What contact did so far.
@@ -148,6 +150,7 @@ impl Integrator {
             max_stretch: 4.0,
             forces: Vec::new(),
             preconditioner: None,
+            incomplete_pattern: PatternChoice::default(),
             direct_pattern: None,
             contact_stats: ContactStats::default(),
             near_pairs: NearPairs::default(),

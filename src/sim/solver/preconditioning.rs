@@ -8,7 +8,7 @@ use crate::sim::linalg::BlockCsr;
 use crate::sim::model::CompressedEdges;
 use super::settings::GlobalPreconditioner;
 use super::Integrator;
-use crate::sim::linalg::{CgReport, DirectFactor, DirectPattern, Multigrid, Preconditioner, SystemMatrix, pcg};
+use crate::sim::linalg::{CgReport, DirectFactor, DirectPattern, FactorPattern, Multigrid, Preconditioner, SystemMatrix, pcg};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -133,7 +133,7 @@ impl Integrator {
             watch.forces();
             let system = SystemMatrix { stiffness: bounded, ..*system };
             if self.preconditioner_is_stale(n) {
-                let preconditioner = self.global_factor(&system, y).unwrap_or_else(|| system.preconditioner());
+                let preconditioner = self.global_factor(&system, y).unwrap_or_else(|| system.preconditioner(FactorPattern::Wide));
                 report.factorizations += 1;
                 self.preconditioner = Some(CachedPreconditioner::new(n, preconditioner));
                 watch.solve();
@@ -175,8 +175,15 @@ impl Integrator {
             problem.assemble(y, bounded, CompressedEdges::Within(&problem.softening));
             bounded_ready = true;
             watch.forces();
-            let preconditioner = SystemMatrix { stiffness: bounded, ..*system }.preconditioner();
+            if let Some((pattern, work)) = self.preconditioner.as_ref().and_then(CachedPreconditioner::work_per_efold) {
+                self.incomplete_pattern.record(pattern, work);
+            }
+            let pattern = self.incomplete_pattern.next();
+            let preconditioner = SystemMatrix { stiffness: bounded, ..*system }.preconditioner(pattern);
             report.factorizations += 1;
+            if !matches!(preconditioner, Preconditioner::IncompleteCholesky(_)) {
+                self.incomplete_pattern.broke_down(pattern);
+            }
             self.preconditioner = Some(CachedPreconditioner::new(n, preconditioner));
             watch.solve();
         }
@@ -237,13 +244,16 @@ pub(super) struct CachedPreconditioner {
     fresh_rate: Option<f64>,
     /// CG iterations spent beyond that rate since.
     excess: f64,
+    /// CG iterations and e-folds of residual reduction over its life.
+    iterations: f64,
+    efolds: f64,
     /// The shift of the matrix it was made from (`Integrator::solve_shifted`).
     shift: f64,
 }
 
 impl CachedPreconditioner {
     fn new(size: usize, preconditioner: Preconditioner) -> Self {
-        Self { size, preconditioner, fresh_rate: None, excess: 0.0, shift: 0.0 }
+        Self { size, preconditioner, fresh_rate: None, excess: 0.0, iterations: 0.0, efolds: 0.0, shift: 0.0 }
     }
 
     /// Counts a solve's iterations beyond the rate this preconditioner had when new.
@@ -252,6 +262,141 @@ impl CachedPreconditioner {
         let efolds = (-cg.relative_residual.max(1e-16).ln()).max(1.0);
         let fresh_rate = *self.fresh_rate.get_or_insert(cg.iterations as f64 / efolds);
         self.excess += (cg.iterations as f64 - fresh_rate * efolds).max(0.0);
+        self.iterations += cg.iterations as f64;
+        self.efolds += efolds;
+    }
+
+    /// An incomplete factor's pattern and what it cost over its life, building included,
+    /// in multiply-adds per e-fold of residual reduction; None for other preconditioners or
+    /// one that solved nothing.
+    fn work_per_efold(&self) -> Option<(FactorPattern, f64)> {
+        let Preconditioner::IncompleteCholesky(factor) = &self.preconditioner else { return None };
+        let iterations = self.iterations + factor.cost_in_iterations;
+        (self.efolds > 0.0).then(|| (factor.pattern, iterations * factor.iteration_cost / self.efolds))
     }
 }
 
+/// The pattern of the next incomplete factor, by the work each has measured: multiply-adds
+/// per e-fold of residual reduction over a factor's life, its building included, smoothed
+/// over the factors made since. Which is cheaper depends
+/// on what sets the slow modes (`FactorPattern`) and can change within a run, so the one
+/// not taken is tried again after a number of factors that doubles, up to
+/// `MAX_PROBE_INTERVAL`, each time it is found still the dearer. Counts, not clocks, decide:
+/// a run takes the same path on every machine.
+#[derive(Debug, Clone)]
+pub(super) struct PatternChoice {
+    /// Smoothed work per e-fold, by pattern (`Wide`, `Ring`); None until measured.
+    work: [Option<f64>; 2],
+    /// Factors made since each pattern was last taken.
+    since: [usize; 2],
+    /// Factors after which the pattern not taken is tried again.
+    interval: usize,
+    /// The pattern of the factor in use, and whether it was a trial of the dearer one.
+    current: (usize, bool),
+}
+
+const MIN_PROBE_INTERVAL: usize = 4;
+const MAX_PROBE_INTERVAL: usize = 64;
+
+impl Default for PatternChoice {
+    fn default() -> Self {
+        Self { work: [None; 2], since: [0; 2], interval: MIN_PROBE_INTERVAL, current: (0, false) }
+    }
+}
+
+impl PatternChoice {
+    const PATTERNS: [FactorPattern; 2] = [FactorPattern::Wide, FactorPattern::Ring];
+
+    /// The pattern for the factor about to be made: each once in turn (the wide first),
+    /// then the cheaper, or the other when its retrial is due.
+    pub(super) fn next(&mut self) -> FactorPattern {
+        let (pick, trial) = match self.work {
+            [None, _] => (0, false),
+            [Some(_), None] => (1, false),
+            [Some(wide), Some(ring)] => {
+                let best = usize::from(ring < wide);
+                if self.since[1 - best] >= self.interval { (1 - best, true) } else { (best, false) }
+            }
+        };
+        self.since = self.since.map(|s| s + 1);
+        self.since[pick] = 0;
+        self.current = (pick, trial);
+        Self::PATTERNS[pick]
+    }
+
+    /// A retired factor's work per e-fold of residual reduction.
+    pub(super) fn record(&mut self, pattern: FactorPattern, work: f64) {
+        if work.is_finite() && work > 0.0 {
+            self.measured(pattern, work);
+        }
+    }
+
+    /// A factorisation on `pattern` broke down even shifted (block Jacobi served instead):
+    /// that pattern counts as the dearer until a later trial succeeds.
+    pub(super) fn broke_down(&mut self, pattern: FactorPattern) {
+        self.measured(pattern, f64::INFINITY);
+    }
+
+    fn measured(&mut self, pattern: FactorPattern, work: f64) {
+        let i = Self::PATTERNS.iter().position(|&p| p == pattern).expect("one of the two");
+        self.work[i] = Some(match self.work[i] {
+            Some(old) if old.is_finite() && work.is_finite() => 0.5 * (old + work),
+            _ => work,
+        });
+        if self.current == (i, true) {
+            // A trial of the dearer pattern: wait twice as long for the next if it is still
+            // the dearer, start over if it won.
+            let other = self.work[1 - i].unwrap_or(f64::INFINITY);
+            self.interval = if work < other { MIN_PROBE_INTERVAL } else { (2 * self.interval).min(MAX_PROBE_INTERVAL) };
+            self.current.1 = false;
+        }
+    }
+}
+
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use FactorPattern::{Ring, Wide};
+
+    /// `n` factors in a row, each measured at `work` for its pattern; the patterns taken.
+    fn run(choice: &mut PatternChoice, n: usize, work: impl Fn(FactorPattern) -> f64) -> Vec<FactorPattern> {
+        (0..n)
+            .map(|_| {
+                let pattern = choice.next();
+                choice.record(pattern, work(pattern));
+                pattern
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_cheaper_pattern_is_taken_and_the_other_retried_ever_less_often() {
+        let mut choice = PatternChoice::default();
+        let taken = run(&mut choice, 40, |p| if p == Ring { 1.0 } else { 3.0 });
+        assert_eq!(&taken[..2], &[Wide, Ring], "each is measured once, the wide first");
+        let trials: Vec<usize> = (2..taken.len()).filter(|&i| taken[i] == Wide).collect();
+        // Retried once 4 factors have been made since it was last taken (the wide at 0, the
+        // ring at 1-4), then 8, then 16: each trial found the wide still the dearer.
+        assert_eq!(trials, vec![5, 14, 31]);
+        // A change in which is cheaper is picked up at the next trial.
+        let taken = run(&mut choice, 80, |p| if p == Ring { 5.0 } else { 1.0 });
+        assert_eq!(taken.last(), Some(&Wide));
+        assert!(taken[taken.len() - 10..].iter().all(|&p| p == Wide));
+    }
+
+    #[test]
+    fn a_pattern_that_broke_down_is_left_until_its_trial() {
+        let mut choice = PatternChoice::default();
+        assert_eq!(choice.next(), Wide);
+        choice.record(Wide, 2.0);
+        assert_eq!(choice.next(), Ring);
+        choice.broke_down(Ring);
+        let next: Vec<FactorPattern> = run(&mut choice, 4, |_| 2.0);
+        assert_eq!(next, vec![Wide; 4]);
+        // Its trial succeeds and is cheaper: it is taken from then on.
+        assert_eq!(choice.next(), Ring);
+        choice.record(Ring, 1.0);
+        assert_eq!(run(&mut choice, 3, |p| if p == Ring { 1.0 } else { 2.0 }), vec![Ring; 3]);
+    }
+}

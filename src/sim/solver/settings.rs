@@ -72,8 +72,9 @@ pub enum PreconditionerChoice {
     /// The complete factor from `AUTO_CHOLESKY_VERTICES` vertices up, the incomplete one below.
     #[default]
     Auto,
-    /// Block incomplete LDLᵀ on the matrix's pattern: cheap to build, and enough on coarse
-    /// meshes, where the bending modes it misses are few.
+    /// Block incomplete LDLᵀ, on the matrix's whole pattern or on its one-ring, whichever
+    /// has measured cheaper so far in the run: cheap to build, and enough on coarse meshes,
+    /// where the bending modes it misses are few.
     IncompleteCholesky,
     /// Sparse Cholesky (faer, with a fill-reducing ordering): more memory and a costlier
     /// build, but CG iterations that stay at a few per Newton iteration at any mesh size.
