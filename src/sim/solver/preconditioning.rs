@@ -179,10 +179,17 @@ impl Integrator {
                 self.incomplete_pattern.record(pattern, work);
             }
             let pattern = self.incomplete_pattern.next();
-            let preconditioner = SystemMatrix { stiffness: bounded, ..*system }.preconditioner(pattern);
+            let bounded_system = SystemMatrix { stiffness: bounded, ..*system };
+            let mut preconditioner = bounded_system.preconditioner(pattern);
             report.factorizations += 1;
             if !matches!(preconditioner, Preconditioner::IncompleteCholesky(_)) {
                 self.incomplete_pattern.broke_down(pattern);
+                // Block Jacobi would serve a whole solve, hundreds of CG iterations on a
+                // drape; the wide pattern breaks down far more rarely.
+                if pattern == FactorPattern::Ring {
+                    preconditioner = bounded_system.preconditioner(FactorPattern::Wide);
+                    report.factorizations += 1;
+                }
             }
             self.preconditioner = Some(CachedPreconditioner::new(n, preconditioner));
             watch.solve();
