@@ -331,23 +331,16 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
     // against a 0.035 µm tolerance, docs/performance-log.md). The step is then taken whole
     // (short of any cloth–cloth pair) and the next iteration judges it.
     let unresolvable = -slope <= ROUNDOFF_ULPS * f64::EPSILON * phi0.abs();
-    for _ in 0..if unresolvable { 0 } else { 30 } {
+    for _ in 0..30 {
         for i in 0..n {
             trial[i] = y[i] + alpha * direction[i];
         }
         phi = problem.objective(trial);
-        if phi.is_finite() && phi <= phi0 + 1e-4 * alpha * slope {
+        if phi.is_finite() && (unresolvable || phi <= phi0 + 1e-4 * alpha * slope) {
             accepted = true;
             break;
         }
         alpha *= 0.5;
-    }
-    if unresolvable {
-        for i in 0..n {
-            trial[i] = y[i] + alpha * direction[i];
-        }
-        phi = problem.objective(trial);
-        accepted = phi.is_finite();
     }
     let length = direction.iter().map(|d| d.length()).fold(0.0, f64::max);
     if accepted && alpha == 1.0 && length > 10.0 * problem.tolerance {

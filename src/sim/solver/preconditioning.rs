@@ -285,11 +285,10 @@ impl CachedPreconditioner {
 
 /// The pattern of the next incomplete factor, by the work each has measured: multiply-adds
 /// per e-fold of residual reduction over a factor's life, its building included, smoothed
-/// over the factors made since. Which is cheaper depends
-/// on what sets the slow modes (`FactorPattern`) and can change within a run, so the one
-/// not taken is tried again after a number of factors that doubles, up to
-/// `MAX_PROBE_INTERVAL`, each time it is found still the dearer. Counts, not clocks, decide:
-/// a run takes the same path on every machine.
+/// over the factors made since. Which is cheaper depends on what sets the slow modes
+/// (`FactorPattern`) and can change within a run, so the one not taken is tried again after
+/// a number of factors that doubles, up to `MAX_PROBE_INTERVAL`, each time it is found
+/// still the dearer. Counts, not clocks, decide: a run takes the same path on every machine.
 #[derive(Debug, Clone)]
 pub(super) struct PatternChoice {
     /// Smoothed work per e-fold, by pattern (`Wide`, `Ring`); None until measured.
@@ -338,8 +337,8 @@ impl PatternChoice {
         }
     }
 
-    /// A factorisation on `pattern` broke down even shifted (block Jacobi served instead):
-    /// that pattern counts as the dearer until a later trial succeeds.
+    /// A factorisation on `pattern` broke down even shifted: that pattern counts as the
+    /// dearer until a later trial succeeds.
     pub(super) fn broke_down(&mut self, pattern: FactorPattern) {
         self.measured(pattern, f64::INFINITY);
     }
