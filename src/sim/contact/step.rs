@@ -196,8 +196,6 @@ impl StepContacts {
         alpha.max(0.0)
     }
 
-
-
     /// The rank-one Gauss–Newton terms of the active cloth–cloth pairs at `y`.
     pub fn couplings(&self, y: &[DVec3], out: &mut Vec<Coupling>) {
         for p in &self.pairs {

@@ -177,7 +177,7 @@ impl Integrator {
             }
         }
         report.timings += watch.timings;
-        report.newton_residual = history.previous_direction.or(history.previous_step).map_or(f64::INFINITY, |step| step / model.mean_edge_length);
+        report.newton_residual = history.previous_direction.map_or(f64::INFINITY, |step| step / model.mean_edge_length);
         report.newton_tolerance = problem.tolerance / model.mean_edge_length;
     }
 
