@@ -161,6 +161,12 @@ pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
             }
         }
         level.solver.newton.error_share = fast.error_share;
+        // A cloth landing on a prop buckles in most iterations of its landing steps: once
+        // the exact matrix has failed in a step, the rest of the step is solved on the
+        // bounded one instead of trying the exact one first again (docs/fast-path.md).
+        if !slow {
+            level.solver.newton.retry_exact = false;
+        }
     }
     level
 }

@@ -137,7 +137,16 @@ impl Scene {
     }
 
     /// Advances one step and samples the rig's measurements on schedule.
+    ///
+    /// The step runs on a thread of rayon's pool: called from any other thread, each of
+    /// the step's parallel loops (two per CG iteration) would be handed to the pool and
+    /// the caller put to sleep until it ends, a futex wake and wait every time; from a
+    /// pool thread a loop starts in place and the other threads steal from it.
     pub fn step(&mut self) -> Result<StepReport, StepError> {
+        rayon::scope(|_| self.step_in_pool())
+    }
+
+    fn step_in_pool(&mut self) -> Result<StepReport, StepError> {
         if let (Some(ramp), true) = (self.config.scene.gravity_ramp, self.config.physics.gravity) {
             // Gravity at the end of the step, which is where implicit steps evaluate forces.
             let t = self.state.time + self.integrator.dt;

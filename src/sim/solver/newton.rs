@@ -48,6 +48,9 @@ pub(super) struct NewtonProblem<'a> {
     /// With nothing fixed and nothing touched, the elastic forces are internal: momentum is
     /// conserved, and each Newton direction is corrected to keep it so.
     pub all_free: bool,
+    /// Directions solved on the bounded matrix are judged by their estimated distance to
+    /// the solution, not their own length (`NewtonSettings::retry_exact` off).
+    judge_contraction: bool,
 }
 
 impl<'a> NewtonProblem<'a> {
@@ -63,7 +66,7 @@ impl<'a> NewtonProblem<'a> {
         let softening = mass_diagonal.iter().zip(&model.fixed).map(|(&d, &f)| if f { f64::INFINITY } else { SOFTENING_SHARE * d }).collect();
         let all_free = !model.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
         let base_tolerance = tolerance * model.mean_edge_length;
-        Self { step, contacts, mass_diagonal, softening, tolerance: base_tolerance, base_tolerance, error_share, error_cap, all_free }
+        Self { step, contacts, mass_diagonal, softening, tolerance: base_tolerance, base_tolerance, error_share, error_cap, all_free, judge_contraction: false }
     }
 
     /// Sets the tolerance for an iterate `y`: a solve an order of magnitude more exact than
@@ -125,6 +128,9 @@ struct NewtonHistory {
     /// The length of the previous Newton direction, whatever part of it was taken: how far
     /// the solution still was, as far as Newton could tell.
     previous_direction: Option<f64>,
+    /// This iteration's direction was solved on the bounded matrix, which is not Φ's
+    /// Hessian along the buckling modes: Newton converges linearly there.
+    bounded_direction: bool,
 }
 
 /// How an iteration's line search ended.
@@ -140,6 +146,7 @@ impl Integrator {
     pub(super) fn newton(&mut self, step: &ImplicitStep, contacts: Option<&StepContacts>, y: &mut Vec<DVec3>, report: &mut StepReport) {
         let model = step.model;
         let mut problem = NewtonProblem::new(step, contacts, self.newton.tolerance, self.newton.error_share, self.last_step_error);
+        problem.judge_contraction = !self.newton.retry_exact;
         let n = y.len();
         let mut work = NewtonWork {
             stiffness: model.stiffness_matrix(),
@@ -166,7 +173,7 @@ impl Integrator {
             let bending = model.bending_newton_matrix(y);
             let cg_tolerance = self.forcing_tolerance(&history, norm, problem.tolerance);
             history.previous_norm = Some(norm);
-            self.solve_direction(&problem, &mut work, y, bending.as_deref(), cg_tolerance, &mut history.bounded_throughout, report, &mut watch);
+            history.bounded_direction = self.solve_direction(&problem, &mut work, y, bending.as_deref(), cg_tolerance, &mut history.bounded_throughout, report, &mut watch);
             if problem.all_free {
                 keep_momentum(&problem.mass_diagonal, &work.gradient, &mut work.direction);
             }
@@ -271,7 +278,7 @@ impl Integrator {
     /// meets a direction of negative curvature or returns no descent, and the solve is
     /// repeated with the softening bounded so that the matrix stays positive definite. With a
     /// global preconditioner (fine meshes) the exact matrix is shifted instead
-    /// (`solve_shifted`).
+    /// (`solve_shifted`). Returns whether the direction was solved on the bounded matrix.
     #[allow(clippy::too_many_arguments)]
     fn solve_direction(
         &mut self,
@@ -283,20 +290,28 @@ impl Integrator {
         bounded_throughout: &mut bool,
         report: &mut StepReport,
         watch: &mut Stopwatch,
-    ) {
+    ) -> bool {
         if let Some(c) = problem.contacts {
             work.couplings.clear();
             c.couplings(y, &mut work.couplings);
             watch.contact();
         }
-        problem.assemble(y, &mut work.stiffness, CompressedEdges::Exact);
-        watch.forces();
+        // Once this step has given up the exact matrix (`NewtonSettings::retry_exact`
+        // decides for the incomplete factor), only the bounded one is assembled, where the
+        // solve needs it.
+        let global = self.newton.preconditioner.global(y.len()).is_some();
+        let exact_first = !*bounded_throughout || (!global && self.newton.retry_exact);
+        if exact_first {
+            problem.assemble(y, &mut work.stiffness, CompressedEdges::Exact);
+            watch.forces();
+        }
         let model = problem.step.model;
         let system = SystemMatrix { mass_diagonal: &problem.mass_diagonal, stiffness: &work.stiffness, bending, fixed: &model.fixed, couplings: &work.couplings };
-        if self.newton.preconditioner.global(y.len()).is_some() {
+        if global {
             self.solve_global(problem, &system, &mut work.bounded, y, &work.rhs, &mut work.direction, cg_tolerance, bounded_throughout, report, watch);
+            *bounded_throughout
         } else {
-            self.solve_incomplete(problem, &system, &mut work.bounded, y, &work.gradient, &work.rhs, &mut work.direction, cg_tolerance, report, watch);
+            self.solve_incomplete(problem, &system, &mut work.bounded, y, &work.gradient, &work.rhs, &mut work.direction, cg_tolerance, bounded_throughout, report, watch)
         }
     }
 }
@@ -368,6 +383,22 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
     history.phi_current = Some(phi).filter(|_| accepted);
     watch.forces();
     let step_size = alpha * length;
+    // On the bounded matrix Newton converges linearly along the buckling modes: directions
+    // shrinking by θ per iteration leave the solution about θ/(1 − θ) times the last one
+    // away, more than the last direction itself once θ > ½ (the stopping test of a
+    // simplified Newton iteration, docs/solvers.md). A landing cloth's bounded iterations
+    // shrink by 0.85–0.95 near the end: stopped at the last direction's length they are
+    // several tolerances short. Where the path decides the result (drops, with
+    // `retry_exact` off) that is judged; on a slowly loaded drape it cost the 20k drape a
+    // sixth more time for the same drape (docs/fast-path.md). A direction from the exact
+    // matrix converges quadratically, and its own length is the honest test.
+    let remaining = match history.previous_direction {
+        Some(before) if problem.judge_contraction && history.bounded_direction && length < before => {
+            let theta = length / before;
+            length * theta / (1.0 - theta)
+        }
+        _ => 0.0,
+    };
     history.previous_step = Some(step_size);
     history.previous_full_step = Some(length).filter(|_| accepted && alpha == 1.0);
     history.previous_direction = Some(length);
@@ -384,7 +415,7 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
         }
     }
     std::mem::swap(y, trial);
-    if length.max(step_size) < problem.tolerance { Progress::Converged } else { Progress::Continue }
+    if length.max(step_size).max(remaining) < problem.tolerance { Progress::Converged } else { Progress::Continue }
 }
 
 /// With nothing fixed and nothing touched, corrects a Newton direction d so that momentum

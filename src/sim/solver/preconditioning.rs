@@ -148,7 +148,10 @@ impl Integrator {
 
     /// Solves Newton's system with the incomplete factor, made from the bounded matrix: on
     /// the exact matrix first, and again on the bounded one (assembled into `bounded`) if
-    /// CG meets negative curvature or returns no descent.
+    /// CG meets negative curvature or returns no descent; without the first attempt once
+    /// one has failed in this step (`bounded_throughout`) unless `NewtonSettings::retry_exact`.
+    /// `system` holds the exact matrix only where the first attempt is made. Returns whether
+    /// the direction was solved on the bounded matrix.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn solve_incomplete(
         &mut self,
@@ -160,10 +163,12 @@ impl Integrator {
         rhs: &[DVec3],
         direction: &mut [DVec3],
         cg_tolerance: f64,
+        bounded_throughout: &mut bool,
         report: &mut StepReport,
         watch: &mut Stopwatch,
-    ) {
+    ) -> bool {
         let n = y.len();
+        let exact_first = self.newton.retry_exact || !*bounded_throughout;
         let mut bounded_ready = false;
         if self.preconditioner_is_stale(n) {
             // Factors are made from the bounded matrix. Made from the exact one, the Euler
@@ -195,23 +200,32 @@ impl Integrator {
             watch.solve();
         }
         let cached = self.preconditioner.as_mut().expect("built above");
-        let mut cg = pcg(system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
-        report.cg_iterations += cg.iterations;
-        watch.solve();
-        let descent = gradient.iter().zip(direction.iter()).map(|(g, d)| g.dot(*d)).sum::<f64>() < 0.0;
+        let mut cg = if exact_first {
+            let cg = pcg(system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
+            report.cg_iterations += cg.iterations;
+            watch.solve();
+            Some(cg)
+        } else {
+            None
+        };
+        let descent = || gradient.iter().zip(direction.iter()).map(|(g, d)| g.dot(*d)).sum::<f64>() < 0.0;
         // (A bounded matrix is positive definite: a failure there is left to the line search
         // and its steepest-descent fallback.)
-        if cg.negative_curvature || !descent {
+        let on_bounded = cg.as_ref().is_none_or(|cg| cg.negative_curvature || !descent());
+        if on_bounded {
+            *bounded_throughout = true;
             if !bounded_ready {
                 problem.assemble(y, bounded, CompressedEdges::Within(&problem.softening));
                 watch.forces();
             }
             let system = SystemMatrix { stiffness: bounded, ..*system };
-            cg = pcg(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
-            report.cg_iterations += cg.iterations;
+            let bounded_cg = pcg(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
+            report.cg_iterations += bounded_cg.iterations;
             watch.solve();
+            cg = Some(bounded_cg);
         }
-        cached.record(&cg);
+        cached.record(cg.as_ref().expect("one of the solves above ran"));
+        on_bounded
     }
 
     /// The global preconditioner of `system` (the cloth at `positions`): the complete factor
