@@ -185,13 +185,7 @@ pub fn contact_sheet(comparison: &Comparison, pictures: &[RgbaImage]) -> Result<
             root.draw_text(&picture::wrap(&label, 46)[0], &name, (x, y)).map_err(|e| e.to_string())?;
             let (line, style) = match &e.error {
                 Some(error) => (picture::wrap(&format!("failed: {error}"), 52)[0].clone(), &bad),
-                None => {
-                    let rest = match (e.result.settled, e.result.settle_time_s) {
-                        (true, Some(t)) => format!("settled at {t:.2} s"),
-                        _ => format!("not settled ({:.2} s)", e.result.simulated_s),
-                    };
-                    (format!("DC {:.3}   {} nodes   {rest}", e.result.drape_coefficient, e.result.nodes), &small)
-                }
+                None => (format!("DC {:.3}   {} nodes   {}", e.result.drape_coefficient, e.result.nodes, e.result.settle_status()), &small),
             };
             root.draw_text(&line, style, (x, y + 24)).map_err(|e| e.to_string())?;
         }

@@ -249,6 +249,15 @@ impl DrapeResult {
         }
         result
     }
+
+    /// "settled at T s", or "not settled after T s" with the time simulated: the card's and
+    /// the contact sheet's wording.
+    pub fn settle_status(&self) -> String {
+        match (self.settled, self.settle_time_s) {
+            (true, Some(t)) => format!("settled at {t:.2} s"),
+            _ => format!("not settled after {:.2} s", self.simulated_s),
+        }
+    }
 }
 
 /// One sheet value read back by a virtual test (fabrics made from sheets).

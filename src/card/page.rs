@@ -201,15 +201,11 @@ fn tables(area: &Area, card: &Card) -> DrawResult {
     let d = &card.drape;
     let mut t = Table { area: &columns[2], y: 8 };
     t.heading(&format!("Cusick drape ({})", d.scene))?;
-    let settled = match (d.result.settled, d.result.settle_time_s) {
-        (true, Some(s)) => format!("settled at {s:.2} s"),
-        _ => format!("not settled after {:.2} s", d.result.simulated_s),
-    };
     let lines = [
         format!("drape coefficient DC  {:.3}", d.result.drape_coefficient),
         format!("nodes  {}", d.result.nodes),
         format!("shadow radius  {:.1} to {:.1} mm", d.result.outline_radius_min_mm, d.result.outline_radius_max_mm),
-        settled,
+        d.result.settle_status(),
         format!("mesh  {} triangles, {:.1} mm edges", d.triangles, d.edge_length_mm),
     ];
     for line in lines {
