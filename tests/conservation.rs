@@ -358,7 +358,6 @@ fn shifted_newton_steps_land_within_the_tolerance_of_converged_steps() {
     }
 }
 
-
 /// Drops on the fast path keep the bounded matrix for the rest of a step once the exact
 /// one has met negative curvature (`retry_exact` off) instead of trying the exact matrix
 /// first in every iteration. The rough crumpled sheet above at 1 ms, with the incomplete

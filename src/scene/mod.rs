@@ -52,7 +52,6 @@ pub struct Scene {
 /// Standard gravity, m/s².
 pub const GRAVITY: f64 = 9.81;
 
-
 /// From this many triangles a step runs on rayon's pool (`Scene::step`): the size from
 /// which the model's, the contact's and the matrices' loops run in parallel (4 096
 /// triangles or rows).

@@ -311,7 +311,7 @@ impl Integrator {
             self.solve_global(problem, &system, &mut work.bounded, y, &work.rhs, &mut work.direction, cg_tolerance, bounded_throughout, report, watch);
             *bounded_throughout
         } else {
-            self.solve_incomplete(problem, &system, &mut work.bounded, y, &work.gradient, &work.rhs, &mut work.direction, cg_tolerance, bounded_throughout, report, watch)
+            self.solve_incomplete(problem, &system, &mut work.bounded, y, &work.gradient, &work.rhs, &mut work.direction, cg_tolerance, exact_first, bounded_throughout, report, watch)
         }
     }
 }

@@ -148,10 +148,10 @@ impl Integrator {
 
     /// Solves Newton's system with the incomplete factor, made from the bounded matrix: on
     /// the exact matrix first, and again on the bounded one (assembled into `bounded`) if
-    /// CG meets negative curvature or returns no descent; without the first attempt once
-    /// one has failed in this step (`bounded_throughout`) unless `NewtonSettings::retry_exact`.
-    /// `system` holds the exact matrix only where the first attempt is made. Returns whether
-    /// the direction was solved on the bounded matrix.
+    /// CG meets negative curvature or returns no descent; without the first attempt unless
+    /// `exact_first` (the caller's choice, `NewtonSettings::retry_exact`), and `system` holds
+    /// the exact matrix only then. A failed first attempt sets `bounded_throughout` for the
+    /// rest of the step. Returns whether the direction was solved on the bounded matrix.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn solve_incomplete(
         &mut self,
@@ -163,12 +163,12 @@ impl Integrator {
         rhs: &[DVec3],
         direction: &mut [DVec3],
         cg_tolerance: f64,
+        exact_first: bool,
         bounded_throughout: &mut bool,
         report: &mut StepReport,
         watch: &mut Stopwatch,
     ) -> bool {
         let n = y.len();
-        let exact_first = self.newton.retry_exact || !*bounded_throughout;
         let mut bounded_ready = false;
         if self.preconditioner_is_stale(n) {
             // Factors are made from the bounded matrix. Made from the exact one, the Euler
