@@ -55,8 +55,8 @@ pub(super) struct NewtonProblem<'a> {
 
 impl<'a> NewtonProblem<'a> {
     /// Newton's tolerance is `tolerance` mean edges, or `error_share` of the step's local
-    /// error where that is more.
-    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64, error_share: f64, error_cap: f64) -> Self {
+    /// error where that is more; `judge_contraction` as the field.
+    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64, error_share: f64, error_cap: f64, judge_contraction: bool) -> Self {
         let ImplicitStep { model, h, .. } = *step;
         let zeta = model.options.damping;
         let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
@@ -66,7 +66,7 @@ impl<'a> NewtonProblem<'a> {
         let softening = mass_diagonal.iter().zip(&model.fixed).map(|(&d, &f)| if f { f64::INFINITY } else { SOFTENING_SHARE * d }).collect();
         let all_free = !model.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
         let base_tolerance = tolerance * model.mean_edge_length;
-        Self { step, contacts, mass_diagonal, softening, tolerance: base_tolerance, base_tolerance, error_share, error_cap, all_free, judge_contraction: false }
+        Self { step, contacts, mass_diagonal, softening, tolerance: base_tolerance, base_tolerance, error_share, error_cap, all_free, judge_contraction }
     }
 
     /// Sets the tolerance for an iterate `y`: a solve an order of magnitude more exact than
@@ -145,8 +145,7 @@ impl Integrator {
     /// Newton's method on the incremental potential Φ (plus contact), from `y` in place.
     pub(super) fn newton(&mut self, step: &ImplicitStep, contacts: Option<&StepContacts>, y: &mut Vec<DVec3>, report: &mut StepReport) {
         let model = step.model;
-        let mut problem = NewtonProblem::new(step, contacts, self.newton.tolerance, self.newton.error_share, self.last_step_error);
-        problem.judge_contraction = !self.newton.retry_exact;
+        let mut problem = NewtonProblem::new(step, contacts, self.newton.tolerance, self.newton.error_share, self.last_step_error, !self.newton.retry_exact);
         let n = y.len();
         let mut work = NewtonWork {
             stiffness: model.stiffness_matrix(),

@@ -200,32 +200,33 @@ impl Integrator {
             watch.solve();
         }
         let cached = self.preconditioner.as_mut().expect("built above");
-        let mut cg = if exact_first {
+        let exact = exact_first.then(|| {
             let cg = pcg(system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
             report.cg_iterations += cg.iterations;
             watch.solve();
-            Some(cg)
-        } else {
-            None
-        };
+            cg
+        });
         let descent = || gradient.iter().zip(direction.iter()).map(|(g, d)| g.dot(*d)).sum::<f64>() < 0.0;
         // (A bounded matrix is positive definite: a failure there is left to the line search
         // and its steepest-descent fallback.)
-        let on_bounded = cg.as_ref().is_none_or(|cg| cg.negative_curvature || !descent());
-        if on_bounded {
-            *bounded_throughout = true;
-            if !bounded_ready {
-                problem.assemble(y, bounded, CompressedEdges::Within(&problem.softening));
-                watch.forces();
+        let cg = match exact {
+            Some(cg) if !cg.negative_curvature && descent() => cg,
+            _ => {
+                *bounded_throughout = true;
+                if !bounded_ready {
+                    problem.assemble(y, bounded, CompressedEdges::Within(&problem.softening));
+                    watch.forces();
+                }
+                let system = SystemMatrix { stiffness: bounded, ..*system };
+                let cg = pcg(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
+                report.cg_iterations += cg.iterations;
+                watch.solve();
+                cached.record(&cg);
+                return true;
             }
-            let system = SystemMatrix { stiffness: bounded, ..*system };
-            let bounded_cg = pcg(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
-            report.cg_iterations += bounded_cg.iterations;
-            watch.solve();
-            cg = Some(bounded_cg);
-        }
-        cached.record(cg.as_ref().expect("one of the solves above ran"));
-        on_bounded
+        };
+        cached.record(&cg);
+        false
     }
 
     /// The global preconditioner of `system` (the cloth at `positions`): the complete factor
@@ -372,7 +373,6 @@ impl PatternChoice {
         }
     }
 }
-
 
 #[cfg(test)]
 mod tests {
