@@ -49,8 +49,8 @@ impl NearPairs {
     /// (docs/fast-path.md). Taking a common motion out changes no pair's distance at any
     /// point of the step, but keeps it out of the boxes: a resting drape's predicted path
     /// includes the step's whole fall under gravity (h²g, 4 cm at 64 ms), and with it the
-    /// boxes of its sloping skirt met 1.8 million pairs at 20 000 triangles (against
-    /// 30 000 without it), 0.45 s a search.
+    /// boxes of its sloping skirt met 1.8 million pairs at 20 000 triangles, 0.45 s a
+    /// search, where the same step's search along its actual paths met 30 000.
     pub(super) fn swept(a: &[DVec3], b: &[DVec3], centre: DVec3, triangles: &[[u32; 3]], edges: &[[u32; 2]], reach: f64) -> Self {
         let boxes: Vec<_> = a.iter().zip(b).map(|(&p, &q)| path_box(p, q, centre)).collect();
         Self::search(&boxes, mean_edge(a, triangles), triangles, edges, reach)
