@@ -415,7 +415,7 @@ mod tests {
             d.map(|di| (di - centre).length())
         };
         // The paths less the cloth's mean motion.
-        let centre = start.iter().zip(predicted).map(|(a, b)| *b - *a).sum::<DVec3>() / start.len() as f64;
+        let centre = common_motion(start, predicted, relative);
         let paths_meet = |one: &[usize], other: &[usize]| {
             let span = |ids: &[usize], k: usize| {
                 let ends = ids.iter().flat_map(|&i| [start[i][k], predicted[i][k] - centre[k]]);
