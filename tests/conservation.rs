@@ -4,7 +4,7 @@
 
 use glam::{DVec2, DVec3};
 use rosette::scene::load_scene;
-use rosette::sim::{Fabric, Integrator, IntegratorKind, Mesh, Model, Pattern, PhysicsOptions, PiecewiseLinear, PreconditionerChoice, State, StepError};
+use rosette::sim::{Fabric, Integrator, IntegratorKind, Mesh, Minimizer, Model, Pattern, PhysicsOptions, PiecewiseLinear, PreconditionerChoice, State, StepError};
 
 /// The paper's wool (bundled preset): nonlinear warp and weft curves, G = 40 N/m, ν = 0.15.
 fn wool() -> Fabric {
@@ -399,4 +399,53 @@ fn steps_that_keep_the_bounded_matrix_land_within_the_tolerance_of_converged_ste
         assert_ne!(cg_keeping, cg_retrying, "{kind}: the exact matrix never failed: the test no longer exercises the bounded one");
         assert!(worst < bound, "{kind}: a step keeping the bounded matrix missed the converged one by {worst:.2e} m (tolerance {bound:.2e} m)");
     }
+}
+
+/// The quasi-Newton step (the fast path's step for cloth in motion) minimises the same
+/// incremental potential by L-BFGS on a constant matrix, to the fast path's tolerance (a
+/// tenth of the step's own integration error). The rough crumpled sheet above at 1 ms, both
+/// integrators: each step must land within the tolerance it stopped at of the converged
+/// Newton step from the same state, with the quasi-Newton iterations alone (a budget large
+/// enough that Newton never finishes the solve), so that its own convergence test is what
+/// is checked.
+#[test]
+fn quasi_newton_steps_land_within_the_tolerance_of_converged_steps() {
+    let model = free_model(&wool(), Pattern::Jittered, 0.01, true);
+    let dt = 1e-3;
+    for kind in [IntegratorKind::ImplicitEuler, IntegratorKind::Bdf2] {
+        let mut reference = converged_integrator(kind, dt);
+        reference.newton.forcing = false;
+        reference.newton.tolerance *= 1e-3;
+        let mut quasi = Integrator::new(kind, dt);
+        quasi.newton.minimizer = Minimizer::QuasiNewton;
+        quasi.newton.quasi_newton_iterations = 2000;
+        quasi.newton.error_share = 0.1;
+        let mut state = crumpled(&model, true);
+        let (mut worst, mut iterations) = (0.0f64, 0);
+        for n in 0..10 {
+            let mut fast = state.clone();
+            let report = quasi.step(&model, &mut fast).unwrap_or_else(|e| panic!("{kind} step {n}: {e}"));
+            assert!(!report.newton_unconverged, "{kind} step {n}: the solve did not converge");
+            assert_eq!(report.newton_iterations, 0, "{kind} step {n}: Newton had to finish the quasi-Newton solve");
+            iterations += report.quasi_newton_iterations;
+            reference.step(&model, &mut state).unwrap_or_else(|e| panic!("{kind} reference step {n}: {e}"));
+            let miss = fast.x.iter().zip(&state.x).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
+            let tolerance = report.newton_tolerance * model.mean_edge_length;
+            worst = worst.max(miss / tolerance);
+        }
+        println!("{kind}: worst miss {worst:.2} of the step's tolerance; {iterations} quasi-Newton iterations in 10 steps");
+        assert!(worst < 1.0, "{kind}: a quasi-Newton step missed the converged one by {worst:.2} of its tolerance");
+    }
+}
+
+/// The quasi-Newton directions are corrected as Newton's are on a free sheet, so that the
+/// solve's residual leaves no net force: momentum is conserved to round-off.
+#[test]
+fn quasi_newton_steps_conserve_momentum() {
+    let model = free_model(&wool(), Pattern::Jittered, 0.01, true);
+    assert_implicit_momentum(&model, "quasi-Newton", |kind, dt| {
+        let mut integrator = Integrator::new(kind, dt);
+        integrator.newton.minimizer = Minimizer::QuasiNewton;
+        integrator
+    });
 }

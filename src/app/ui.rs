@@ -481,6 +481,10 @@ impl ViewerUi {
             row("steps per second", format!("{:.1}", s.steps_per_second));
             row("CPU per 10 ms simulated", format!("{:.3} ms", s.cpu_ms_per_10ms));
             row("real-time factor", format!("{:.2}", s.real_time_factor));
+            row("step, Δt", format!("{}, {} s", s.minimizer, s.step_dt));
+            if s.quasi_newton_iterations > 0 {
+                row("quasi-Newton iterations", format!("{}", s.quasi_newton_iterations));
+            }
             row("Newton / CG iterations", format!("{} / {}", s.newton_iterations, s.cg_iterations));
             row("kinetic energy", format!("{:.4e} J", s.kinetic_energy));
             row("membrane energy", format!("{:.4e} J", s.membrane_energy));

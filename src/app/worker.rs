@@ -94,6 +94,11 @@ pub struct Stats {
     pub newton_iterations: usize,
     /// Conjugate-gradient iterations of the last step.
     pub cg_iterations: usize,
+    /// Quasi-Newton iterations of the last step (the fast path's step for cloth in motion).
+    pub quasi_newton_iterations: usize,
+    /// How the running level minimises each step ("newton" or "quasi-newton") and its Δt, s.
+    pub minimizer: &'static str,
+    pub step_dt: f64,
     /// Steps since the scene started whose Newton solve stopped short of its tolerance (by
     /// more than `UNCONVERGED_FACTOR`), as `rosette run` counts them against exit 5.
     pub unconverged_steps: u64,
@@ -572,6 +577,12 @@ impl WorkerState {
             bending_energy,
             newton_iterations: self.last_report.newton_iterations,
             cg_iterations: self.last_report.cg_iterations,
+            quasi_newton_iterations: self.last_report.quasi_newton_iterations,
+            minimizer: match self.scene.integrator.newton.minimizer {
+                crate::sim::Minimizer::QuasiNewton => "quasi-newton",
+                _ => "newton",
+            },
+            step_dt: self.scene.integrator.dt,
             unconverged_steps: self.unconverged.0,
             worst_residual: self.unconverged.1,
             ..Default::default()

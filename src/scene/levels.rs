@@ -88,7 +88,7 @@ impl Default for FastSettings {
 /// the experiment).
 pub fn schedule(config: &SceneConfig) -> Result<Option<Vec<f64>>, SceneError> {
     let solver = &config.solver;
-    if solver.path != SolverPath::Fast || config.scene.settle_speed.is_none() {
+    if solver.path != SolverPath::Fast || (config.scene.settle_speed.is_none() && quasi_static(config)) {
         return Ok(None);
     }
     if solver.integrator.is_explicit() {
@@ -98,8 +98,13 @@ pub fn schedule(config: &SceneConfig) -> Result<Option<Vec<f64>>, SceneError> {
                 .into(),
         ));
     }
-    let coarsest = coarsest_edge(config).map_err(crate::sim::ModelError::from)?;
     let mut edges = vec![config.mesh.edge_length];
+    if config.scene.settle_speed.is_none() {
+        // A cloth in motion that is not watched for settling: its own mesh throughout (the
+        // levels' transfers happen when a level settles), with the fast path's step.
+        return Ok(Some(edges));
+    }
+    let coarsest = coarsest_edge(config).map_err(crate::sim::ModelError::from)?;
     while 2.0 * edges[0] <= coarsest {
         edges.insert(0, 2.0 * edges[0]);
     }
@@ -167,6 +172,7 @@ pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
         if !slow {
             level.solver.newton.retry_exact = false;
         }
+
     }
     level
 }

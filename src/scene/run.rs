@@ -60,6 +60,9 @@ pub struct Metrics {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact_events: Option<ContactEvents>,
     pub newton_iterations: u64,
+    /// Iterations of the quasi-Newton step (`solver.newton.minimizer = "quasi-newton"`).
+    #[serde(default)]
+    pub quasi_newton_iterations: u64,
     pub cg_iterations: u64,
     /// Preconditioners built for the linear solves (factorisations).
     pub factorizations: u64,
@@ -126,6 +129,7 @@ pub struct StepRecord {
     /// The step's Δt, s.
     pub dt: f64,
     pub newton_iterations: usize,
+    pub quasi_newton_iterations: usize,
     pub cg_iterations: usize,
     pub factorizations: usize,
     /// The largest shift Newton's matrix took, as a share of the inertia (0 where none).
@@ -145,12 +149,12 @@ pub struct StepRecord {
 impl StepRecord {
     /// The CSV header matching `csv_row`.
     pub const CSV_HEADER: &'static str =
-        "step,time_s,dt_s,newton,cg,factorizations,shift,newton_unconverged,rms_speed_m_s,cpu_s,forces_s,solve_s,contact_s,newton_residual";
+        "step,time_s,dt_s,newton,cg,factorizations,shift,newton_unconverged,rms_speed_m_s,cpu_s,forces_s,solve_s,contact_s,newton_residual,quasi_newton";
 
     pub fn csv_row(&self) -> String {
         let t = &self.timings;
         format!(
-            "{},{},{:e},{},{},{},{},{},{:.4e},{:.4},{:.3e},{:.3e},{:.3e},{:.3e}",
+            "{},{},{:e},{},{},{},{},{},{:.4e},{:.4},{:.3e},{:.3e},{:.3e},{:.3e},{}",
             self.step,
             self.time,
             self.dt,
@@ -164,7 +168,8 @@ impl StepRecord {
             t.forces,
             t.solve,
             t.contact,
-            self.newton_residual
+            self.newton_residual,
+            self.quasi_newton_iterations
         )
     }
 }
@@ -255,7 +260,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let wall = Instant::now();
     let cpu = cpu_time::ProcessTime::now();
     let start_time = scene.state.time;
-    let (mut newton, mut cg, mut factorizations) = (0u64, 0u64, 0u64);
+    let (mut newton, mut quasi_newton, mut cg, mut factorizations) = (0u64, 0u64, 0u64, 0u64);
     let mut step_time = StepTimings::default();
     let mut rejected = 0u64;
     let mut error = None;
@@ -284,6 +289,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             }
         };
         newton += report.newton_iterations as u64;
+        quasi_newton += report.quasi_newton_iterations as u64;
         cg += report.cg_iterations as u64;
         factorizations += report.factorizations as u64;
         step_time += report.timings;
@@ -298,6 +304,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
                 time: scene.state.time,
                 dt: report.dt,
                 newton_iterations: report.newton_iterations,
+                quasi_newton_iterations: report.quasi_newton_iterations,
                 cg_iterations: report.cg_iterations,
                 factorizations: report.factorizations,
                 shift: report.shift,
@@ -351,6 +358,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             ContactEvents { impacts: s.impacts, resolves: s.resolves }
         }),
         newton_iterations: newton,
+        quasi_newton_iterations: quasi_newton,
         cg_iterations: cg,
         factorizations,
         rejected_steps: rejected,

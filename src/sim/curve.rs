@@ -112,6 +112,13 @@ impl PiecewiseLinear {
     }
 
     /// The energy `∫₀ˣ y dx`.
+    /// `(integral(x), value(x))`, the segment searched once.
+    pub fn integral_and_value(&self, x: f64) -> (f64, f64) {
+        let i = self.segment(x);
+        let (dx, slope) = (x - self.xs[i], self.slope_of_segment(i));
+        (self.integral_at_knot[i] + self.ys[i] * dx + 0.5 * slope * dx * dx, self.ys[i] + slope * dx)
+    }
+
     pub fn integral(&self, x: f64) -> f64 {
         let i = self.segment(x);
         let dx = x - self.xs[i];

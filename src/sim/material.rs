@@ -289,6 +289,18 @@ impl MembraneLaw {
             + 0.5 * self.shear * e[2] * e[2]
     }
 
+    /// `(energy(e), stress(e))`, each curve searched once.
+    pub fn energy_and_stress(&self, e: [f64; 3]) -> (f64, [f64; 3]) {
+        let ((ix, fx), (iy, fy)) = (self.warp.integral_and_value(e[0]), self.weft.integral_and_value(e[1]));
+        let energy = ix
+            + iy
+            + 0.5 * (self.correction_x * e[0] * e[0] + self.correction_y * e[1] * e[1])
+            + self.coupling * e[0] * e[1]
+            + 0.5 * self.shear * e[2] * e[2];
+        let stress = [fx + self.correction_x * e[0] + self.coupling * e[1], fy + self.correction_y * e[1] + self.coupling * e[0], self.shear * e[2]];
+        (energy, stress)
+    }
+
     /// Stress `[σ_xx, σ_yy, τ_xy]` = ∂ψ/∂ε, N/m.
     pub fn stress(&self, e: [f64; 3]) -> [f64; 3] {
         [

@@ -14,7 +14,7 @@ pub mod solver;
 pub const MODEL_REVISION: u32 = 2;
 
 pub use curve::PiecewiseLinear;
-pub use solver::{AdaptiveStep, Integrator, IntegratorKind, NewtonSettings, PreconditionerChoice, State, StepError, StepReport, StepTimings};
+pub use solver::{AdaptiveStep, Integrator, IntegratorKind, Minimizer, NewtonSettings, PreconditionerChoice, State, StepError, StepReport, StepTimings};
 pub use material::{BendingStiffness, Fabric, FabricError, FabricPoints, MembraneLaw};
 pub use mesh::{Mesh, MeshError, Pattern};
 pub use model::{Model, ModelError, Motion, PhysicsOptions};

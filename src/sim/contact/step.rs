@@ -70,6 +70,43 @@ impl StepContacts {
         e
     }
 
+    /// Adds ∇(energy) to `g` and returns the energy: [`Self::energy`] and
+    /// [`Self::add_gradient`] from one pass.
+    pub fn energy_and_gradient(&self, y: &[DVec3], anchor: &[DVec3], g: &mut [DVec3], fixed: &[bool]) -> f64 {
+        let mut e = 0.0;
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let gap = self.thickness - c.normal.dot(y[i] - c.point);
+            if gap > 0.0 {
+                e += 0.5 * c.stiffness * gap * gap;
+                g[i] -= c.stiffness * gap * c.normal;
+            }
+            if c.normal_force > 0.0 {
+                let u = y[i] - anchor[i];
+                let t = u - u.dot(c.normal) * c.normal;
+                let slip = t.length();
+                let (value, slope) = self.friction(slip);
+                e += c.normal_force * value;
+                if slip > 0.0 {
+                    g[i] += c.normal_force * slope * t / slip;
+                }
+            }
+        }
+        for p in &self.pairs {
+            let (d, n, w) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                let f = p.stiffness * (self.self_thickness - d);
+                e += 0.5 * p.stiffness * (self.self_thickness - d).powi(2);
+                for (&j, &weight) in p.vertices.iter().zip(&w) {
+                    if !fixed[j as usize] {
+                        g[j as usize] -= f * weight * n;
+                    }
+                }
+            }
+        }
+        e
+    }
+
     /// Adds ∇(energy) to `g`.
     pub fn add_gradient(&self, y: &[DVec3], anchor: &[DVec3], g: &mut [DVec3], fixed: &[bool]) {
         for c in &self.planes {
@@ -138,6 +175,36 @@ impl StepContacts {
                 for (&j, &weight) in p.vertices.iter().zip(&w) {
                     let slot = k.diagonal_slot(j);
                     k.values[slot] += nn * (weight * weight);
+                }
+            }
+        }
+    }
+}
+
+impl StepContacts {
+    /// Adds to each vertex's entry of `diagonal` the stiffness its contacts have at `y` in
+    /// their stiffest direction (the penalty's k where the vertex is inside a prop's layer,
+    /// friction's curvature across the slip λF'(s)/s, the cloth–cloth pairs' k w²), as an
+    /// isotropic term: the quasi-Newton step's matrix takes contact in that form.
+    pub fn add_isotropic_stiffness(&self, y: &[DVec3], anchor: &[DVec3], diagonal: &mut [f64]) {
+        for c in &self.planes {
+            let i = c.vertex as usize;
+            let mut k: f64 = 0.0;
+            if self.thickness - c.normal.dot(y[i] - c.point) > 0.0 {
+                k = c.stiffness;
+            }
+            if c.normal_force > 0.0 {
+                let u = y[i] - anchor[i];
+                let slip = (u - u.dot(c.normal) * c.normal).length().max(self.slip);
+                k = k.max(c.normal_force * self.friction(slip).1 / slip);
+            }
+            diagonal[i] += k;
+        }
+        for p in &self.pairs {
+            let (d, _, w) = self.self_distance(p, y);
+            if d < self.self_thickness {
+                for (&j, &weight) in p.vertices.iter().zip(&w) {
+                    diagonal[j as usize] += p.stiffness * weight * weight;
                 }
             }
         }

@@ -50,6 +50,19 @@ impl Model {
     }
 
 
+    /// Adds the bending forces to `f` and returns the bending energy, J (one pass over Q
+    /// for linear bending).
+    pub(super) fn add_bending_energy_and_forces(&self, x: &[DVec3], f: &mut [DVec3]) -> f64 {
+        match (&self.bending, &self.bending_curve) {
+            (Some(q), None) => subtract_quadratic_force_with_energy(q, x, f),
+            _ => {
+                self.add_bending_forces(x, f);
+                self.bending_energy(x)
+            }
+        }
+    }
+
+
     /// Builds the bending stencils, Q and (for nonlinear bending) each triangle's share of
     /// Q, with `rigid` marking clamped vertices.
     pub(super) fn build_bending(&mut self, rigid: &[bool]) -> Result<(), ModelError> {
@@ -163,6 +176,25 @@ fn quadratic_energy(q: &ScalarCsr, x: &[DVec3]) -> f64 {
         return 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>();
     }
     0.5 * sum_of(x.len(), |a| q.entries_of_row(a as u32).map(|(b, v)| v * x[a].dot(x[b as usize])).sum::<f64>())
+}
+
+/// f −= Q x and the energy ½ xᵀQx = −¼ Σ_ab Q_ab |x_b − x_a|² (Q's rows sum to zero), both
+/// from the differences x_b − x_a of one pass over Q's rows.
+fn subtract_quadratic_force_with_energy(q: &ScalarCsr, x: &[DVec3], f: &mut [DVec3]) -> f64 {
+    let row = |a: usize| {
+        let xa = x[a];
+        q.entries_of_row(a as u32).fold((DVec3::ZERO, 0.0), |(force, energy), (b, v)| {
+            let d = x[b as usize] - xa;
+            (force + v * d, energy + v * d.length_squared())
+        })
+    };
+    let mut energy = 0.0;
+    for (a, fa) in f.iter_mut().enumerate() {
+        let (force, e) = row(a);
+        *fa -= force;
+        energy -= 0.25 * e;
+    }
+    energy
 }
 
 /// f −= Q x for an energy ½ Σ Q_ab x_a·x_b whose rows sum to zero, written as

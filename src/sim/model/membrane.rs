@@ -3,10 +3,10 @@
 //! Hessian in 3×3 blocks.
 
 use super::{Model, PARALLEL_TRIANGLES, outer, sum_of, to_warp_frame};
-use crate::sim::linalg::BlockCsr;
+use crate::sim::linalg::{BlockCsr, ScalarCsr};
 use crate::sim::material::MembraneLaw;
 use crate::sim::mesh::Mesh;
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 
 /// Rest data of one triangle's strain rosette (paper Fig. 1).
 #[derive(Debug, Clone)]
@@ -73,6 +73,40 @@ impl Model {
     }
 
 
+    /// Adds the membrane forces to `f` and returns the membrane energy, J: both from one
+    /// pass over the triangles (the quasi-Newton step evaluates them at every trial).
+    pub(super) fn add_membrane_energy_and_forces(&self, x: &[DVec3], f: &mut [DVec3]) -> f64 {
+        use rayon::prelude::*;
+        let Some(law) = &self.membrane_law else { return 0.0 };
+        let evaluate = |tri: &RosetteTriangle| {
+            let (strain, dirs, _) = rosette_strain(tri, x);
+            let (psi, stress) = law.energy_and_stress(strain);
+            let tension = edge_tensions(tri, stress);
+            (tri.area * psi, [0, 1, 2].map(|k| tension[k] * dirs[k]))
+        };
+        let mut energy = 0.0;
+        let mut add = |tri: &RosetteTriangle, (e, pull): (f64, [DVec3; 3])| {
+            energy += e;
+            for (k, pull) in pull.into_iter().enumerate() {
+                let (a, b) = edge_vertices(tri, k);
+                f[a as usize] += pull;
+                f[b as usize] -= pull;
+            }
+        };
+        if self.rosettes.len() < PARALLEL_TRIANGLES {
+            for tri in &self.rosettes {
+                add(tri, evaluate(tri));
+            }
+        } else {
+            let all: Vec<(f64, [DVec3; 3])> = self.rosettes.par_iter().map(evaluate).collect();
+            for (tri, item) in self.rosettes.iter().zip(all) {
+                add(tri, item);
+            }
+        }
+        energy
+    }
+
+
     /// Assembles the in-plane stiffness (the Hessian of the membrane energy, with the
     /// geometric stiffness of compressed edges dropped so that it stays positive
     /// semi-definite) into `k`, which must have this model's pattern.
@@ -118,6 +152,52 @@ impl Model {
             let blocks: Vec<[DMat3; 6]> = self.rosettes.par_iter().map(|tri| triangle_stiffness(tri, law, x, &ratio)).collect();
             for (tri, b) in self.rosettes.iter().zip(&blocks) {
                 add(k, tri, b);
+            }
+        }
+    }
+
+
+    /// Adds the membrane's rest stiffness, made to act alike on x, y and z, to `s` (whose
+    /// pattern must hold the mesh's edges): for each triangle Σ_pq s_pa s_qb K_pq (u_p·u_q),
+    /// where the true rest Hessian has the blocks Σ_pq s_pa s_qb K_pq u_p u_qᵀ
+    /// (`triangle_stiffness` at zero strain). The Hadamard product of K (positive
+    /// semi-definite) and the Gram matrix of the edge directions is positive semi-definite
+    /// (Schur's product theorem), and it annihilates rigid translations. Like the matrix of
+    /// projective dynamics it does not change as the cloth moves or rotates: the
+    /// quasi-Newton step factors it once.
+    pub fn add_isotropic_rest_stiffness(&self, s: &mut ScalarCsr) {
+        let Some(law) = &self.membrane_law else { return };
+        let c = law.tangent([0.0; 3]);
+        for tri in &self.rosettes {
+            let g = &tri.strain_from_edges;
+            let dirs: [DVec2; 3] = [0, 1, 2].map(|k| {
+                let (a, b) = edge_vertices(tri, k);
+                (self.rest[b as usize] - self.rest[a as usize]) / tri.rest_length[k]
+            });
+            let mut ke = [[0.0; 3]; 3];
+            for p in 0..3 {
+                for q in 0..3 {
+                    let mut sum = 0.0;
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            sum += g[i][p] * c[i][j] * g[j][q];
+                        }
+                    }
+                    ke[p][q] = tri.area * sum / (tri.rest_length[p] * tri.rest_length[q]) * dirs[p].dot(dirs[q]);
+                }
+            }
+            let edges_of = |a: usize| [((a + 1) % 3, 1.0), ((a + 2) % 3, -1.0)];
+            for a in 0..3 {
+                for b in 0..3 {
+                    let mut value = 0.0;
+                    for (p, sp) in edges_of(a) {
+                        for (q, sq) in edges_of(b) {
+                            value += sp * sq * ke[p][q];
+                        }
+                    }
+                    let slot = s.slot(tri.vertices[a], tri.vertices[b]);
+                    s.values[slot] += value;
+                }
             }
         }
     }

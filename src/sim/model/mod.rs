@@ -226,6 +226,23 @@ impl Model {
         self.add_bending_forces(x, f);
     }
 
+    /// Total conservative force −∇E into `f` (overwritten) and the potential energy E, J, from
+    /// one pass over the elements: the same quantities as [`Model::forces`] and
+    /// [`Model::potential_energy`], for the quasi-Newton step, which needs both at every trial.
+    pub fn energy_and_forces(&self, x: &[DVec3], f: &mut [DVec3]) -> f64 {
+        f.fill(DVec3::ZERO);
+        let mut energy = 0.0;
+        if self.options.gravity != DVec3::ZERO {
+            let g = self.options.gravity;
+            for ((fi, m), xi) in f.iter_mut().zip(&self.mass).zip(x) {
+                *fi += *m * g;
+                energy -= *m * g.dot(*xi);
+            }
+        }
+        energy += self.add_membrane_energy_and_forces(x, f);
+        energy + self.add_bending_energy_and_forces(x, f)
+    }
+
     /// A zero matrix with the in-plane stiffness pattern.
     pub fn stiffness_matrix(&self) -> BlockCsr {
         self.stiffness_pattern.clone()
@@ -233,6 +250,35 @@ impl Model {
 
     pub fn has_membrane(&self) -> bool {
         self.membrane_law.is_some()
+    }
+
+    /// The constant parts of the quasi-Newton step's matrices, scalar matrices acting alike
+    /// on x, y and z on the mesh's one-ring pattern (the in-plane stiffness pattern's):
+    /// the membrane's isotropic rest stiffness, and the bending matrix Q restricted to the
+    /// one-ring, each entry dropped from Q added as |q| to both its diagonals. That
+    /// restriction is at least Q (the difference is a sum of |q|(e_i ∓ e_j)(e_i ∓ e_j)ᵀ), so
+    /// it is positive semi-definite and never softer than the bending it stands for, and its
+    /// factor has a tenth of the fill of Q's two-ring stencil's (68 798 against 701 151
+    /// entries on the 7 938-triangle sphere drop).
+    pub fn quasi_newton_matrices(&self) -> (ScalarCsr, ScalarCsr) {
+        let n = self.vertex_count();
+        let mut membrane = ScalarCsr::with_pattern(n, self.edges.iter().map(|e| (e[0], e[1])));
+        let mut bending = membrane.clone();
+        self.add_isotropic_rest_stiffness(&mut membrane);
+        if let Some(q) = &self.bending {
+            for (r, c, v) in q.entries() {
+                if r == c {
+                    let slot = bending.slot(r, r);
+                    bending.values[slot] += v;
+                } else if let Ok(slot) = bending.find(r, c) {
+                    bending.values[slot] += v;
+                } else {
+                    let slot = bending.slot(r, r);
+                    bending.values[slot] += v.abs();
+                }
+            }
+        }
+        (membrane, bending)
     }
 }
 

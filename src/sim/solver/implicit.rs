@@ -46,7 +46,7 @@ impl Integrator {
         let mut report = StepReport::default();
         let mut step_contacts = None;
         match &model.contact {
-            None => self.newton(&step, None, &mut y, &mut report),
+            None => self.minimize(&step, None, &mut y, &mut report),
             Some(contact) => {
                 let mut watch = Stopwatch::start();
                 // The prediction includes gravity's pull over the step, so that contacts a
@@ -69,7 +69,7 @@ impl Integrator {
                 watch.contact();
                 // Solve; a path that enters a prop without a plane adds one and solves again.
                 for pass in 0..4 {
-                    self.newton(&step, Some(&contacts), &mut y, &mut report);
+                    self.minimize(&step, Some(&contacts), &mut y, &mut report);
                     watch.restart();
                     let missed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &y, h);
                     watch.contact();
@@ -109,6 +109,23 @@ impl Integrator {
         }
         s.previous = Some(previous);
         report
+    }
+}
+
+impl Integrator {
+    /// Minimises Φ from `y` with the step's method: Newton, or the quasi-Newton step with
+    /// Newton finishing what it has not converged (its linear convergence is slow where
+    /// the tolerance is tight, as when the cloth comes to rest; Newton's is quadratic from
+    /// a start that close).
+    fn minimize(&mut self, step: &ImplicitStep, contacts: Option<&crate::sim::contact::StepContacts>, y: &mut Vec<DVec3>, report: &mut StepReport) {
+        match self.newton.minimizer {
+            super::Minimizer::Newton => self.newton(step, contacts, y, report),
+            super::Minimizer::QuasiNewton => {
+                if !self.quasi_newton(step, contacts, y, report) {
+                    self.newton(step, contacts, y, report);
+                }
+            }
+        }
     }
 }
 

@@ -20,11 +20,12 @@ mod explicit;
 mod implicit;
 mod newton;
 mod preconditioning;
+mod quasi_newton;
 mod report;
 mod settings;
 
 pub use report::{StepError, StepReport, StepTimings, UNCONVERGED_FACTOR};
-pub use settings::{AdaptiveStep, DEFAULT_MAX_ITERATIONS, Indefinite, NewtonSettings, PreconditionerChoice};
+pub use settings::{AdaptiveStep, DEFAULT_MAX_ITERATIONS, Indefinite, Minimizer, NewtonSettings, PreconditionerChoice};
 
 use crate::sim::contact::{ContactModel, ContactStats, NearPairs};
 use crate::sim::linalg::DirectPattern;
@@ -138,6 +139,10 @@ pub struct Integrator {
     /// The last step's local error estimate ½Δt·max|v_{n+1} − v_n|, m; infinite before the
     /// first step (`NewtonSettings::error_share`).
     last_step_error: f64,
+    /// The quasi-Newton step's matrices (`Minimizer::QuasiNewton`).
+    quasi: Option<quasi_newton::StepMatrices>,
+    /// The quasi-Newton step's iteration budget for the next step (`quasi_newton.rs`).
+    quasi_budget: usize,
 }
 
 impl Integrator {
@@ -157,6 +162,8 @@ impl Integrator {
             shift: 0.0,
             needed_shift: 0.0,
             last_step_error: f64::INFINITY,
+            quasi: None,
+            quasi_budget: usize::MAX,
         }
     }
 

@@ -56,7 +56,7 @@ pub(super) struct NewtonProblem<'a> {
 impl<'a> NewtonProblem<'a> {
     /// Newton's tolerance is `tolerance` mean edges, or `error_share` of the step's local
     /// error where that is more; `judge_contraction` as the field.
-    fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64, error_share: f64, error_cap: f64, judge_contraction: bool) -> Self {
+    pub(super) fn new(step: &'a ImplicitStep<'a>, contacts: Option<&'a StepContacts>, tolerance: f64, error_share: f64, error_cap: f64, judge_contraction: bool) -> Self {
         let ImplicitStep { model, h, .. } = *step;
         let zeta = model.options.damping;
         let mass_diagonal: Vec<f64> = model.mass.iter().map(|m| m * (1.0 / (h * h) + zeta / h)).collect();
@@ -73,7 +73,7 @@ impl<'a> NewtonProblem<'a> {
     /// the step it serves (`NewtonSettings::error_share` of its local error, estimated at
     /// `y` and at most the previous step's) adds nothing a user could see in a moving cloth,
     /// and at rest the base tolerance holds.
-    fn update_tolerance(&mut self, y: &[DVec3]) {
+    pub(super) fn update_tolerance(&mut self, y: &[DVec3]) {
         self.tolerance = if self.error_share > 0.0 {
             self.base_tolerance.max(self.error_share * self.step.local_error(y).min(self.error_cap))
         } else {
@@ -188,7 +188,7 @@ impl Integrator {
     }
 
     /// ∇Φ at `y` into `gradient` (zero on fixed vertices), and its norm.
-    fn gradient(&mut self, problem: &NewtonProblem, y: &[DVec3], gradient: &mut [DVec3], watch: &mut Stopwatch) -> f64 {
+    pub(super) fn gradient(&mut self, problem: &NewtonProblem, y: &[DVec3], gradient: &mut [DVec3], watch: &mut Stopwatch) -> f64 {
         let ImplicitStep { model, h, anchor, inertial, .. } = *problem.step;
         let zeta = model.options.damping;
         let n = y.len();
@@ -421,7 +421,7 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
 /// is conserved to round-off whatever the solve's error. The elastic Hessian annihilates
 /// translations, so adding a constant c to d changes only the mass term of H d; choosing c
 /// so that Σ M (d + c) = −Σ g removes the net force the residual would leave.
-fn keep_momentum(mass_diagonal: &[f64], gradient: &[DVec3], direction: &mut [DVec3]) {
+pub(super) fn keep_momentum(mass_diagonal: &[f64], gradient: &[DVec3], direction: &mut [DVec3]) {
     let (mut mass_sum, mut residual) = (0.0, DVec3::ZERO);
     for ((&m, &g), &d) in mass_diagonal.iter().zip(gradient).zip(direction.iter()) {
         mass_sum += m;

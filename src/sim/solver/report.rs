@@ -20,6 +20,9 @@ pub enum StepError {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct StepReport {
     pub newton_iterations: usize,
+    /// Iterations of the quasi-Newton step (`Minimizer::QuasiNewton`), before any Newton
+    /// iterations that finished its solve.
+    pub quasi_newton_iterations: usize,
     pub cg_iterations: usize,
     /// Preconditioners built (factorisations, complete or incomplete; failed ones included).
     pub factorizations: usize,
@@ -57,6 +60,7 @@ impl StepReport {
     /// Adds another attempt's work (iterations and time).
     pub(super) fn add_work(&mut self, other: &StepReport) {
         self.newton_iterations += other.newton_iterations;
+        self.quasi_newton_iterations += other.quasi_newton_iterations;
         self.cg_iterations += other.cg_iterations;
         self.factorizations += other.factorizations;
         self.timings += other.timings;

@@ -60,6 +60,37 @@ pub struct NewtonSettings {
     /// "bound"`, the incomplete factor's solves take the bounded matrix from a step's first
     /// iteration, as the global ones do.)
     pub retry_exact: bool,
+    /// How Φ is minimised: Newton's method, or the quasi-Newton step (`quasi_newton.rs`).
+    pub minimizer: Minimizer,
+    /// The quasi-Newton step's memory: how many of the last iterations' (step, gradient
+    /// change) pairs correct its matrix.
+    pub quasi_newton_history: usize,
+    /// The quasi-Newton step's iterations before Newton finishes the solve from where it
+    /// got to (Newton then has `max_iterations` of its own).
+    pub quasi_newton_iterations: usize,
+}
+
+/// How an implicit step minimises its incremental potential.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Minimizer {
+    /// Newton's method with the exact Hessian (shifted or bounded where indefinite),
+    /// preconditioned conjugate gradients and a line search.
+    #[default]
+    Newton,
+    /// L-BFGS on the projective-dynamics matrix of the model, factored once per step with
+    /// no assembly and no conjugate gradient per iteration; Newton finishes a solve it has
+    /// not converged in `quasi_newton_iterations`.
+    QuasiNewton,
+}
+
+impl Minimizer {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Newton => "newton",
+            Self::QuasiNewton => "quasi-newton",
+        }
+    }
 }
 
 /// How Newton's solves with a global preconditioner (the complete factor, multigrid) treat
@@ -127,7 +158,7 @@ impl PreconditionerChoice {
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { max_iterations: DEFAULT_MAX_ITERATIONS, tolerance: 1e-5, error_share: 0.0, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true, warm_start: false, preconditioner: PreconditionerChoice::Auto, indefinite: Indefinite::Shift, retry_exact: true }
+        Self { max_iterations: DEFAULT_MAX_ITERATIONS, tolerance: 1e-5, error_share: 0.0, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true, warm_start: false, preconditioner: PreconditionerChoice::Auto, indefinite: Indefinite::Shift, retry_exact: true, minimizer: Minimizer::Newton, quasi_newton_history: 8, quasi_newton_iterations: 400 }
     }
 }
 

@@ -10,6 +10,10 @@
 //! areal density in kg/m²; weight per area in N/m². Many results are dimensionless
 //! (lengths over the strip length L, loads over the critical load) and say so.
 
+mod chain;
+
+pub use chain::{J0_FIRST_ZERO, bessel_j0, hanging_chain_mode, hanging_chain_period};
+
 use std::f64::consts::{FRAC_PI_2, PI};
 
 // ---------------------------------------------------------------------------------------
