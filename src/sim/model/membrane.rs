@@ -2,11 +2,10 @@
 //! the measured tensile curves ([`MembraneLaw`]), its forces as edge tensions and its
 //! Hessian in 3×3 blocks.
 
-use super::{Model, PARALLEL_TRIANGLES, outer, sum_of, to_warp_frame};
+use super::{Model, PARALLEL_TRIANGLES, outer, sum_of};
 use crate::sim::linalg::BlockCsr;
 use crate::sim::material::MembraneLaw;
-use crate::sim::mesh::Mesh;
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 
 /// Rest data of one triangle's strain rosette (paper Fig. 1).
 #[derive(Debug, Clone)]
@@ -93,6 +92,9 @@ impl Model {
     pub fn assemble_membrane_stiffness_within(&self, x: &[DVec3], k: &mut BlockCsr, compressed: CompressedEdges) {
         use rayon::prelude::*;
         k.clear();
+        if self.sewing.is_active() {
+            self.sewing.add_stiffness(k);
+        }
         let Some(law) = &self.membrane_law else { return };
         // Each vertex's scale for the compressed edges it ends (0: dropped).
         let ratio: Vec<f64> = match compressed {
@@ -252,8 +254,9 @@ fn edge_tensions(tri: &RosetteTriangle, stress: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|k| tri.area * (g[0][k] * stress[0] + g[1][k] * stress[1] + g[2][k] * stress[2]) / tri.rest_length[k])
 }
 
-pub(super) fn rosette(mesh: &Mesh, t: usize, tri: [u32; 3], warp_angle: f64, pattern: &BlockCsr) -> RosetteTriangle {
-    let p = tri.map(|v| to_warp_frame(mesh.rest[v as usize], warp_angle));
+/// The rosette of triangle `tri` whose corners in its warp frame are `p` and whose rest area
+/// is `area` (m²).
+pub(super) fn rosette(p: [DVec2; 3], area: f64, tri: [u32; 3], pattern: &BlockCsr) -> RosetteTriangle {
     let mut rows = [[0.0; 3]; 3];
     let mut rest_length = [0.0; 3];
     for k in 0..3 {
@@ -271,7 +274,7 @@ pub(super) fn rosette(mesh: &Mesh, t: usize, tri: [u32; 3], warp_angle: f64, pat
             slots[a * 3 + b] = pattern.slot(tri[a], tri[b]) as u32;
         }
     }
-    RosetteTriangle { vertices: tri, area: mesh.signed_area(t), rest_length, strain_from_edges, slots }
+    RosetteTriangle { vertices: tri, area, rest_length, strain_from_edges, slots }
 }
 
 fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
