@@ -104,9 +104,10 @@ pub struct Garment {
     pub positions: Vec<DVec3>,
     /// Each seam's vertex pairs, side a then side b, in order along side a.
     pub seams: Vec<Vec<[u32; 2]>>,
-    /// Pinned vertices, and vertices pulled onto the form with the height they go to (m).
+    /// Pinned vertices, and the edges pulled onto the form (their vertices in order) with
+    /// the height they go to (m).
     pub pinned: Vec<u32>,
-    pub attached: Vec<(u32, f64)>,
+    pub attached_edges: Vec<(Vec<u32>, f64)>,
     pub hem: Vec<u32>,
     /// Seam side lengths along the panels (m): (a, b) per seam.
     pub seam_lengths: Vec<(f64, f64)>,
@@ -145,6 +146,16 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
     let lengths: Vec<Vec<f64>> = curves.iter().map(|c| c.iter().map(Polyline::length).collect()).collect();
     let (sides, counts) = seam_sides(config, &names, &lengths, edge_length)?;
     let cuts = seams::cuts(&lengths, &sides, &counts, edge_length, &names)?;
+    // Refinement leaves triangles of about (√3/4) h²: refuse a mesh past the vertex cap
+    // before making it.
+    let area: f64 = curves.iter().map(|c| c.iter().flat_map(|e| e.points.windows(2)).map(|w| 0.5 * w[0].perp_dot(w[1])).sum::<f64>()).sum();
+    let planned = (area / (0.433 * edge_length * edge_length)) as usize / 2;
+    if planned > crate::sim::mesh::MAX_VERTICES {
+        return Err(GarmentError::new(format!(
+            "mesh.edge_length = {edge_length} m gives about {planned} vertices, more than the limit of {}; use a larger edge",
+            crate::sim::mesh::MAX_VERTICES
+        )));
+    }
     let meshes: Vec<PanelMesh> =
         config.panels.iter().zip(&curves).zip(&cuts).map(|((p, c), cut)| mesh::mesh_panel(&p.name, c, cut, edge_length)).collect::<Result<_, _>>()?;
     let grains: Vec<f64> = config.panels.iter().map(|p| p.grain_deg.to_radians()).collect();
@@ -168,7 +179,7 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
         let (p, e) = seams::resolve(key, text, &names)?;
         Ok(meshes[p].edge_vertices[e].iter().map(|v| v + offsets[p]).collect())
     };
-    let (mut pinned, mut attached) = (Vec::new(), Vec::new());
+    let (mut pinned, mut attached_edges) = (Vec::new(), Vec::new());
     for (i, a) in config.attachments.iter().enumerate() {
         let key = format!("garment.attachments[{i}].edge");
         let vertices = edge_vertices(&key, &a.edge)?;
@@ -178,9 +189,9 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
                 let z = levels(level).ok_or_else(|| {
                     GarmentError::new(format!("garment.attachments[{i}].level = \"{level}\": the form has no such level; use waist, hip or bust (a generated form), or height"))
                 })?;
-                attached.extend(vertices.into_iter().map(|v| (v, z)));
+                attached_edges.push((vertices, z));
             }
-            (false, None, Some(h)) if h.is_finite() => attached.extend(vertices.into_iter().map(|v| (v, h * metres))),
+            (false, None, Some(h)) if h.is_finite() => attached_edges.push((vertices, h * metres)),
             _ => return Err(GarmentError::new(format!("garment.attachments[{i}]: give exactly one of pin = true, level or height (finite)"))),
         }
     }
@@ -195,7 +206,7 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
     }
     hem.sort_unstable();
     hem.dedup();
-    Ok(Garment { names, meshes, grains, offsets, surface, positions, seams, pinned, attached, hem, seam_lengths })
+    Ok(Garment { names, meshes, grains, offsets, surface, positions, seams, pinned, attached_edges, hem, seam_lengths })
 }
 
 fn check_names(names: &[(String, Vec<String>)]) -> Result<(), GarmentError> {
