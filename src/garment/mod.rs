@@ -77,10 +77,10 @@ fn default_seam_ease() -> f64 {
     0.05
 }
 fn default_sewing_stiffness() -> f64 {
-    200.0
+    50.0
 }
 fn default_sewing_ramp() -> f64 {
-    0.2
+    0.5
 }
 fn default_sewing_time() -> f64 {
     1.5

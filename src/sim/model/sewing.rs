@@ -139,3 +139,73 @@ impl Model {
         self.frames.is_some()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::material::Fabric;
+    use crate::sim::mesh::{Mesh, Pattern};
+    use crate::sim::model::PhysicsOptions;
+
+    fn fabric() -> Fabric {
+        crate::scene::load_scene("cusick-drape", &[]).unwrap().0.material().unwrap()
+    }
+
+    /// A smooth, non-developable deformation of the rest plane (bending and stretching).
+    fn shape(p: DVec2) -> DVec3 {
+        DVec3::new(p.x + 0.02 * p.y * p.y, p.y - 0.01 * p.x * p.y, 0.6 * p.x * p.x - 0.4 * p.x * p.y + 0.9 * p.y * p.y)
+    }
+
+    /// A rectangle cut into two panels along x = 0.05 (the right one drawn turned by 30°
+    /// and moved, its grain turned with it) and welded back stores the same membrane and
+    /// bending energy, to round-off, as the rectangle cut in one piece: the charts unfolded
+    /// across the seam see the rest plane the single piece has.
+    #[test]
+    fn a_welded_seam_bends_and_stretches_as_uncut_cloth() {
+        let warp = 0.3;
+        let mesh = Mesh::rectangle(0.1, 0.06, 0.01, Pattern::Alternating, 1).unwrap();
+        let options = PhysicsOptions::default();
+        let whole = Model::new(&mesh, &fabric(), warp, options).unwrap();
+        let turn = DVec2::from_angle(0.5236);
+        let moved = |p: DVec2| turn.rotate(p) + DVec2::new(0.3, -0.2);
+        let right = |t: &[u32; 3]| t.iter().map(|&v| mesh.rest[v as usize].x).sum::<f64>() / 3.0 > 0.05;
+        // The right panel's pattern is the moved copy; its warp in its own drawing is the
+        // whole cloth's warp turned the same way.
+        let corners = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let (p, grain) = if right(t) { (t.map(|v| moved(mesh.rest[v as usize])), warp + 0.5236) } else { (t.map(|v| mesh.rest[v as usize]), warp) };
+                p.map(|q| DVec2::from_angle(-grain).rotate(q))
+            })
+            .collect();
+        let surface = PanelSurface { triangles: mesh.triangles.clone(), corners, pattern: mesh.rest.clone() };
+        let welded = Model::from_panels(&surface, &[], &fabric(), options).unwrap();
+        let x: Vec<DVec3> = mesh.rest.iter().map(|&p| shape(p)).collect();
+        let (m0, b0) = whole.elastic_energy(&x);
+        let (m1, b1) = welded.elastic_energy(&x);
+        assert!(b0 > 0.0 && m0 > 0.0);
+        assert!((b1 / b0 - 1.0).abs() < 1e-9, "bending {b1} vs {b0}");
+        assert!((m1 / m0 - 1.0).abs() < 1e-9, "membrane {m1} vs {m0}");
+    }
+
+    /// Sewing springs: energy, forces and Hessian agree (central differences).
+    #[test]
+    fn springs_are_conservative() {
+        let sewing = Sewing { pairs: vec![[0, 1]], anchors: vec![(2, DVec3::new(0.1, 0.2, 0.3))], stiffness: 40.0 };
+        let x = vec![DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.05, -0.02, 0.01), DVec3::new(0.2, 0.1, 0.0)];
+        let mut f = vec![DVec3::ZERO; 3];
+        sewing.add_forces(&x, &mut f);
+        let e = 1e-6;
+        for v in 0..3 {
+            for axis in 0..3 {
+                let (mut plus, mut minus) = (x.clone(), x.clone());
+                plus[v][axis] += e;
+                minus[v][axis] -= e;
+                let derivative = (sewing.energy(&plus) - sewing.energy(&minus)) / (2.0 * e);
+                assert!((derivative + f[v][axis]).abs() < 1e-6, "vertex {v} axis {axis}");
+            }
+        }
+        assert!((sewing.largest_gap(&x) - x[0].distance(x[1])).abs() < 1e-15);
+    }
+}
