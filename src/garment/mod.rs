@@ -63,6 +63,11 @@ pub struct GarmentConfig {
     /// Time over which the springs grow from zero to full, s.
     #[serde(default = "default_sewing_ramp")]
     pub sewing_ramp: f64,
+    /// Air damping while the seams close, 1/s (the scene's `solver.damping` from the weld):
+    /// strong enough that the panels are drawn together without overshoot, whose sides
+    /// would pass each other and be welded folded.
+    #[serde(default = "default_sewing_damping")]
+    pub sewing_damping: f64,
     /// Time by which every seam must be closed, s; a garment still open then is reported as
     /// not sewn.
     #[serde(default = "default_sewing_time")]
@@ -81,6 +86,9 @@ fn default_sewing_stiffness() -> f64 {
 }
 fn default_sewing_ramp() -> f64 {
     0.5
+}
+fn default_sewing_damping() -> f64 {
+    50.0
 }
 fn default_sewing_time() -> f64 {
     1.5

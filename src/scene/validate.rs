@@ -25,7 +25,7 @@ pub(super) fn positive(key: &str, v: f64) -> Result<f64, Invalid> {
     if v.is_finite() && v > 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be a positive number, got {v:?}"))) }
 }
 
-fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
+pub(super) fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
     if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be zero or a positive number, got {v:?}"))) }
 }
 

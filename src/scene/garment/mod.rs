@@ -30,6 +30,8 @@ pub struct Sewing {
     deadline: f64,
     /// A seam is closed when its pairs are this close, m.
     closed_gap: f64,
+    /// Air damping while sewing, and the scene's from the weld on, 1/s.
+    damping: (f64, f64),
     /// The welded cloth's model, built with the scene; taken at the weld.
     welded: Option<Model>,
     /// For each vertex of the unsewn cloth, its vertex in the welded one.
@@ -124,6 +126,7 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
         ramp: g.sewing_ramp,
         deadline: g.sewing_time,
         closed_gap: g.closed_share * thickness,
+        damping: (g.sewing_damping, config.solver.damping),
         welded: Some(welded),
         weld_map,
         pin_after,
@@ -151,6 +154,7 @@ pub fn check(c: &SceneConfig) -> Result<f64, super::validate::Invalid> {
     positive("garment.sewing_ramp", g.sewing_ramp)?;
     positive("garment.sewing_time", g.sewing_time)?;
     positive("garment.closed_share", g.closed_share)?;
+    super::validate::non_negative("garment.sewing_damping", g.sewing_damping)?;
     if g.sewing_time > c.scene.duration {
         return Err(invalid("garment.sewing_time", format!("garment.sewing_time = {} s is longer than scene.duration = {} s", g.sewing_time, c.scene.duration)));
     }
@@ -314,6 +318,7 @@ impl Scene {
         }
         let t = self.state.time + self.integrator.dt;
         self.model.sewing.stiffness = sewing.stiffness * (t / sewing.ramp).min(1.0);
+        self.model.options.damping = sewing.damping.0;
     }
 
     /// After a step: welds the garment once every seam and attachment is closed.
@@ -360,6 +365,7 @@ impl Scene {
             contact.settings.self_collision = sewing.self_collision;
         }
         model.options = self.model.options;
+        model.options.damping = sewing.damping.1;
         let mut state = State::at_rest(position);
         state.v = velocity;
         state.time = self.state.time;
