@@ -217,12 +217,12 @@ fn a_tube_sewn_from_one_rectangle_keeps_no_membrane_strain() {
     assert!(metrics.measures.garment().unwrap().sewn);
     let strains = scene.model.triangle_strains(&scene.state.x);
     let worst = strains.iter().flatten().fold(0.0f64, |m, e| m.max(e.abs()));
-    // The exact reference is zero. What is measured (2 cm mesh, 3 s): about 1.5e-3 of
-    // shear in the middle of the tube and 3e-3 within a few edges of its free rims, with a
-    // slow creep that does not settle in 15 s (open, docs/garments.md); an open seam, or a
-    // seam welded without the panels' rest shapes, strains the tube by the 25 % it was
-    // placed open by. The bound separates those, it does not claim zero.
-    assert!(worst < 5e-3, "largest membrane strain {worst:.2e}");
+    // The exact reference is zero; the bound is the one set before the first run. Measured
+    // (2 cm mesh, 3 s): 1.5e-3, the tube still creeping slowly (docs/garments.md, open
+    // questions). A seam welded folded (sides that overshot each other while sewing)
+    // showed 4.8e-3; a seam welded without the panels' rest shapes would strain the tube by
+    // the 25 % it was placed open by.
+    assert!(worst < 2e-3, "largest membrane strain {worst:.2e}");
     // The tube's radius about its own axis (the mean of its vertices, which stays
     // vertical by symmetry): a 25-gon of the rectangle's 50.27 cm.
     let x = &scene.state.x;
@@ -242,4 +242,68 @@ fn every_bundled_garment_builds() {
         let scene = Scene::build(config).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(scene.garment.is_some() && scene.model.triangle_count() > 100, "{name}");
     }
+}
+
+/// The tension per unit width down a gore hanging from its waist, integrated over its
+/// length: ∫₀ᴸ (∫ₛᴸ w(u) du / w(s)) ds for a width growing linearly from `waist` to `hem`
+/// (m) over `length` (m), by the midpoint rule; the stretch is ρg/E times this.
+fn gore_load_integral(waist: f64, hem: f64, length: f64, from: f64) -> f64 {
+    let n = 2000;
+    let width = |s: f64| waist + (hem - waist) * s / length;
+    let below = |s: f64| (width(s) + hem) / 2.0 * (length - s);
+    let ds = (length - from) / n as f64;
+    (0..n).map(|i| from + (i as f64 + 0.5) * ds).map(|s| below(s) / width(s) * ds).sum()
+}
+
+/// The gored skirt cut on the bias stretches down its gores more than the straight cut by
+/// what the bias's E₄₅ (eq. 1) predicts: each gore's centre line carries the weight of the
+/// cloth below it, ρg ∫ w / w per unit width, so it lengthens by ρg I (1/E_θ) with I the
+/// integral above. The form's hips carry part of the skirt above the hip line, so the
+/// measured difference lies between the prediction from the hip down (the part that hangs
+/// free) and from the waist down; each bound is given 15 % for the coarse mesh's folds,
+/// whose paths along the centre line lengthen it a little in both cuts alike.
+#[test]
+fn the_bias_cut_gores_stretch_by_what_e45_predicts() {
+    let runs: Vec<(f64, f64)> = std::thread::scope(|s| {
+        let handles: Vec<_> = ["skirt-gored-straight", "skirt-gored-bias"]
+            .into_iter()
+            .map(|name| {
+                s.spawn(move || {
+                    let (config, _) = load_scene(name, &["mesh.edge_length=0.04".into()]).unwrap();
+                    let mut scene = Scene::build(config).unwrap();
+                    let (metrics, error) = run_scene(&mut scene, name, RunOptions::default());
+                    assert!(error.is_none() && metrics.measures.garment().unwrap().sewn, "{name}: {error:?}");
+                    // Each gore's centre line on the flat pattern: gores 40 cm wide laid 5 cm
+                    // apart, the hem's lowest point at y = 0 and the waist's at 56.13 cm.
+                    let flat = rosette::sim::Mesh { rest: scene.model.rest.clone(), triangles: scene.model.triangles.clone() };
+                    let rest_length = 0.541131 + 0.020157;
+                    let stretch: f64 = (0..4)
+                        .map(|k| {
+                            let x = k as f64 * 0.45 + 0.20;
+                            let points: Vec<glam::DVec2> = (0..=40).map(|i| glam::DVec2::new(x, rest_length * i as f64 / 40.0)).collect();
+                            let along: Vec<glam::DVec3> = flat.embed(&points).iter().map(|e| e.position(&scene.state.x)).collect();
+                            along.windows(2).map(|w| w[0].distance(w[1])).sum::<f64>() - rest_length
+                        })
+                        .sum::<f64>()
+                        / 4.0;
+                    (stretch, metrics.measures.garment().unwrap().hem_height_mean)
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    let (config, _) = load_scene("skirt-gored-bias", &[]).unwrap();
+    let f = &config.fabric.properties;
+    let (e0, e45) = (
+        modulus_at(0.0, initial_slope(&f.tensile_warp), initial_slope(&f.tensile_weft), f.shear_modulus, f.poisson_warp),
+        modulus_at(45f64.to_radians(), initial_slope(&f.tensile_warp), initial_slope(&f.tensile_weft), f.shear_modulus, f.poisson_warp),
+    );
+    let (length, hip) = (0.5613, 0.206);
+    let weight = f.areal_density * 9.81;
+    let compliance = 1.0 / e45 - 1.0 / e0;
+    let (low, high) = (weight * gore_load_integral(0.176, 0.40, length, hip) * compliance, weight * gore_load_integral(0.176, 0.40, length, 0.0) * compliance);
+    let measured = runs[1].0 - runs[0].0;
+    eprintln!("centre lines stretched {:.2} mm (straight), {:.2} mm (bias); hems at {:.4} m and {:.4} m; eq. 1 predicts {:.2} to {:.2} mm more on the bias",
+        1e3 * runs[0].0, 1e3 * runs[1].0, runs[0].1, runs[1].1, 1e3 * low, 1e3 * high);
+    assert!(measured > 0.85 * low && measured < 1.15 * high, "bias stretched {:.3} mm more, eq. 1 predicts {:.3} to {:.3} mm", 1e3 * measured, 1e3 * low, 1e3 * high);
 }
