@@ -331,16 +331,6 @@ impl Scene {
         // The seams decide: an attached vertex whose anchor disagrees with its seam partner's
         // is pinned where the two settle.
         let gap = self.model.sewing.largest_gap(x);
-        if std::env::var_os("ROSETTE_DEBUG_SEAMS").is_some() && self.state.steps % 50 == 0 {
-            let worst = self.model.sewing.pairs.iter().max_by(|p, q| x[p[0] as usize].distance(x[p[1] as usize]).total_cmp(&x[q[0] as usize].distance(x[q[1] as usize])));
-            if let Some(&[a, b]) = worst {
-                eprintln!("t {:.3} gap {gap:.4} worst pair {a} {b} at {:?} {:?}", self.state.time, x[a as usize], x[b as usize]);
-            }
-            let worst = self.model.sewing.anchors.iter().max_by(|p, q| x[p.0 as usize].distance(p.1).total_cmp(&x[q.0 as usize].distance(q.1)));
-            if let Some(&(v, p)) = worst {
-                eprintln!("   worst anchor {v} at {:?} target {p:?}", x[v as usize]);
-            }
-        }
         if gap > sewing.closed_gap {
             return;
         }
