@@ -14,6 +14,7 @@ pub mod card;
 pub mod chart;
 pub mod export;
 pub mod fabric;
+pub mod garment;
 pub mod lab;
 pub mod reference;
 pub mod render;

@@ -19,8 +19,8 @@ mod cli;
     after_help = "Exit codes: 0 done; 2 bad input, refused before the run; 3 the simulation diverged; \
                   4 an output could not be rendered or written after the run; 5 the run ended but \
                   some Newton solves did not converge (metrics: converged = false); 6 the run \
-                  stopped at --max-steps or --max-wall. Metrics, outline and picture are kept for \
-                  3 to 6."
+                  stopped at --max-steps or --max-wall; 8 a garment's seams were not closed by its \
+                  sewing time. Metrics, outline and picture are kept for 3 to 8."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -199,7 +199,8 @@ struct ScreenshotArgs {
 /// Exit codes (also in `--help` and the README): 0 done, 2 bad input (refused before the
 /// run), 3 the simulation diverged, 4 an output could not be rendered or written after the
 /// run, 5 the run ended but some Newton solves did not converge, 6 the run stopped at its
-/// step or wall-time bound, 7 a fabric's virtual tests disagree with its sheet.
+/// step or wall-time bound, 7 a fabric's virtual tests disagree with its sheet, 8 a
+/// garment's seams were not closed by its sewing time.
 const EXIT_BAD_INPUT: u8 = 2;
 const EXIT_DIVERGED: u8 = 3;
 const EXIT_NO_OUTPUT: u8 = 4;
@@ -207,6 +208,8 @@ const EXIT_NOT_CONVERGED: u8 = 5;
 const EXIT_STOPPED: u8 = 6;
 /// `rosette fabric check`: a virtual test read a sheet value outside its tolerance.
 const EXIT_READBACK: u8 = 7;
+/// A garment whose seams were still open at `garment.sewing_time`: not finished.
+const EXIT_NOT_SEWN: u8 = 8;
 
 /// What `--fast` adds to a scene's overrides.
 const FAST_PATH: &str = "solver.path=fast";
@@ -594,6 +597,14 @@ fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutput
             metrics.newton_limit_steps, metrics.worst_residual, scene.integrator.newton.tolerance
         );
         return ExitCode::from(EXIT_NOT_CONVERGED);
+    }
+    if let Some(garment) = metrics.measures.garment().filter(|g| !g.sewn) {
+        eprintln!(
+            "error: {name}: the garment was not sewn: a seam was still {:.1} mm open at garment.sewing_time, and what was drawn is unfinished; \
+             give the seams more time (garment.sewing_time) or stiffer springs (garment.sewing_stiffness), or place the panels nearer their seams",
+            1e3 * garment.open_seam_gap
+        );
+        return ExitCode::from(EXIT_NOT_SEWN);
     }
     if output_failed {
         return ExitCode::from(EXIT_NO_OUTPUT);

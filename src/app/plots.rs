@@ -83,6 +83,8 @@ pub fn default_series(kind: SceneKind) -> &'static str {
         SceneKind::ShearBuckling => "wrinkle_amplitude",
         // The shadow shrinks as the cloth falls around the pedestal.
         SceneKind::Drape => "drape_coefficient",
+        // The hem falls as the sewn garment drapes on the form.
+        SceneKind::Garment => "hem_height_mean",
     }
 }
 

@@ -92,9 +92,9 @@ pub fn configs(fabrics: &[String], scene: &str, overrides: &[String]) -> Result<
             let mut all = overrides.to_vec();
             all.push(format!("fabric.preset={}", toml::Value::String(fabric.clone())));
             let (config, _) = load_scene(scene, &all).map_err(|e| CardError::BadInput(format!("fabric '{fabric}': {e}")))?;
-            if config.scene.kind != SceneKind::Drape {
+            if !matches!(config.scene.kind, SceneKind::Drape | SceneKind::Garment) {
                 return Err(CardError::BadInput(format!(
-                    "--scene {scene}: not a drape scene, so it has no drape coefficient to compare; use cusick-drape-30, cusick-drape or tablecloth"
+                    "--scene {scene}: not a drape or garment scene, so it has no drape coefficient to compare; use cusick-drape-30, cusick-drape, tablecloth or a garment such as skirt-gored-bias"
                 )));
             }
             Ok(config)
@@ -113,9 +113,11 @@ pub fn run(fabrics: &[String], configs: Vec<SceneConfig>, progress: &Progress) -
         let mut entry = Entry { fabric: fabric.clone(), name, ..Entry::default() };
         let outcome = Scene::build(config.clone()).map_err(|e| e.to_string()).and_then(|mut scene| {
             let (metrics, error) = run_scene(&mut scene, fabric, RunOptions::default());
-            match error {
-                Some(e) => Err(e.to_string()),
-                None => Ok((scene, metrics)),
+            match (error, metrics.measures.garment().filter(|g| !g.sewn)) {
+                (Some(e), _) => Err(e.to_string()),
+                // An unsewn garment is not shown as if it were finished.
+                (None, Some(g)) => Err(format!("not sewn: a seam was still {:.1} mm open at garment.sewing_time", 1e3 * g.open_seam_gap)),
+                (None, None) => Ok((scene, metrics)),
             }
         });
         progress.finish(fabric);

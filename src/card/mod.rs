@@ -247,6 +247,12 @@ impl DrapeResult {
             result.outline_radius_min_mm = 1e3 * d.outline_radius_min.unwrap_or(f64::NAN);
             result.outline_radius_max_mm = 1e3 * d.outline_radius_max;
         }
+        if let Some(g) = metrics.measures.garment() {
+            result.drape_coefficient = g.garment_drape_coefficient;
+            result.nodes = g.hem_nodes;
+            result.outline_radius_min_mm = 1e3 * g.hem_radius_min;
+            result.outline_radius_max_mm = 1e3 * g.hem_radius_max;
+        }
         result
     }
 

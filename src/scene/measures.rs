@@ -25,6 +25,8 @@ pub enum Measures {
     Arc(ArcMeasures),
     Euler(EulerMeasures),
     Shear(ShearMeasures),
+    /// Before `Drape`: a garment's JSON holds fields no drape has, a drape's lacks them.
+    Garment(super::garment::rig::GarmentMeasures),
     Drape(DrapeMeasures),
 }
 
@@ -233,6 +235,10 @@ impl Measures {
         if let Measures::Drape(m) = self { Some(m) } else { None }
     }
 
+    pub fn garment(&self) -> Option<&super::garment::rig::GarmentMeasures> {
+        if let Measures::Garment(m) = self { Some(m) } else { None }
+    }
+
     /// The scalar measures that have a finite value now, by name, in the JSON's key order
     /// (definitions, which are text, and series are left out).
     pub fn scalars(&self) -> Vec<(&'static str, Scalar)> {
@@ -282,6 +288,24 @@ impl Measures {
                 ("specimen_area", Some(Real(m.specimen_area))),
                 ("support_area", Some(Real(m.support_area))),
             ],
+            Measures::Garment(m) => vec![
+                ("garment_drape_coefficient", Some(Real(m.garment_drape_coefficient))),
+                ("hem_height_max", Some(Real(m.hem_height_max))),
+                ("hem_height_mean", Some(Real(m.hem_height_mean))),
+                ("hem_height_min", Some(Real(m.hem_height_min))),
+                ("hem_height_spread", Some(Real(m.hem_height_spread))),
+                ("hem_nodes", Some(Count(m.hem_nodes))),
+                ("hem_radius_max", Some(Real(m.hem_radius_max))),
+                ("hem_radius_min", Some(Real(m.hem_radius_min))),
+                ("open_seam_gap", Some(Real(m.open_seam_gap))),
+                ("panels", Some(Count(m.panels))),
+                ("pattern_area", Some(Real(m.pattern_area))),
+                ("seam_gap_at_weld", m.seam_gap_at_weld.map(Real)),
+                ("seam_pairs", Some(Count(m.seam_pairs))),
+                ("sewn_at", m.sewn_at.map(Real)),
+                ("shadow_area", Some(Real(m.shadow_area))),
+                ("waist_area", Some(Real(m.waist_area))),
+            ],
         };
         all.into_iter().filter_map(|(name, value)| Some((name, value.filter(|v| v.value().is_finite())?))).collect()
     }
@@ -314,7 +338,7 @@ impl Measures {
                 let rows: Vec<[f64; 3]> = m.history.iter().map(|&(t, dc, nodes)| [t, dc, nodes as f64]).collect();
                 vec![series("history", &["time_s", "drape_coefficient", "nodes"], &rows)]
             }
-            Measures::Cantilever(_) | Measures::Arc(_) | Measures::Shear(_) => Vec::new(),
+            Measures::Cantilever(_) | Measures::Arc(_) | Measures::Shear(_) | Measures::Garment(_) => Vec::new(),
         }
     }
 }

@@ -2,6 +2,7 @@
 //! One registry (`preset::SCENES`) feeds the command line, the tests and the viewer.
 
 pub mod drape;
+pub mod garment;
 pub mod levels;
 pub mod measures;
 pub mod memory;
@@ -47,6 +48,8 @@ pub struct Scene {
     /// The edge length of the fast path's level the scene is on (None: the scene's own
     /// mesh and settings).
     level_edge: Option<f64>,
+    /// A garment's sewing (None for other scenes).
+    pub garment: Option<garment::Sewing>,
 }
 
 /// Standard gravity, m/s².
@@ -59,6 +62,12 @@ const POOL_STEP_TRIANGLES: usize = 4096;
 
 impl Scene {
     pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
+        if config.scene.kind == SceneKind::Garment {
+            // A garment settles on its own mesh (its panels are sewn and welded once); the
+            // fast path gives it its long steps and Newton's step-sized tolerance there.
+            let edge = (config.solver.path == levels::SolverPath::Fast).then_some(config.mesh.edge_length);
+            return Self::build_level(config, edge);
+        }
         match levels::schedule(&config)? {
             Some(edges) => {
                 let pending = levels::build_pending(&config, &edges[1..])?;
@@ -83,6 +92,15 @@ impl Scene {
             gravity: if level_config.physics.gravity { DVec3::new(0.0, 0.0, -GRAVITY) } else { DVec3::ZERO },
             damping: level_config.solver.damping,
         };
+        if level_config.scene.kind == SceneKind::Garment {
+            let parts = garment::build(&level_config, &fabric, options)?;
+            let integrator = level_config.solver.integrator();
+            let steps = (config.scene.duration / level_config.solver.dt).ceil().max(1.0) as u64;
+            let rig = Rig::Garment(Box::new(parts.rig));
+            let (state, model, props) = (State::at_rest(parts.x), parts.model, parts.props);
+            let sample_every = (steps / 400).max(1);
+            return Ok(Self { state, config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: Some(parts.sewing) });
+        }
         let c = &level_config.cloth;
         let warp = c.warp_angle_deg.to_radians();
         let drape = level_config.scene.kind == SceneKind::Drape;
@@ -115,7 +133,7 @@ impl Scene {
         let integrator = level_config.solver.integrator();
         let steps = (config.scene.duration / level_config.solver.dt).ceil().max(1.0) as u64;
         let sample_every = (steps / 400).max(1);
-        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length })
+        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: None })
     }
 
     /// Changes the time step (s) and integrator, keeping positions, velocities, time and
@@ -164,7 +182,9 @@ impl Scene {
             let t = self.state.time + self.integrator.dt;
             self.model.options.gravity = DVec3::new(0.0, 0.0, -GRAVITY * (t / ramp).min(1.0));
         }
+        self.sew_before_step();
         let report = self.integrator.step(&self.model, &mut self.state)?;
+        self.sew_after_step();
         if self.state.steps.is_multiple_of(self.sample_every) {
             self.rig.sample(&self.model, &self.state);
         }

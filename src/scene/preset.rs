@@ -28,7 +28,8 @@ macro_rules! bundled {
 /// Bundled scenes; their file stems are the names users type.
 pub const SCENES: &[Bundled] = bundled!("";
     "tensile-warp", "tensile-weft", "tensile-bias", "cantilever", "arc", "euler-buckling", "shear-buckling",
-    "cusick-drape", "cusick-drape-30", "tablecloth", "sphere-drop");
+    "cusick-drape", "cusick-drape-30", "tablecloth", "sphere-drop",
+    "skirt-circle", "skirt-gored-straight", "skirt-gored-bias", "shift-dress");
 
 /// Bundled fabrics.
 pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk", "wool-plain-fast", "wool-worsted", "wool-flannel", "cotton-poplin", "cotton-oxford", "cotton-lawn", "denim-14oz");
@@ -65,6 +66,8 @@ pub enum SceneKind {
     /// A cloth falling or resting on props until it settles: the Cusick drape test
     /// (paper Fig. 6, BS 5058), a tablecloth.
     Drape,
+    /// Pattern pieces sewn into a garment on a dress form (`[garment]`, docs/garments.md).
+    Garment,
 }
 
 /// A complete scene description, after the fabric file and overrides are merged.
@@ -73,6 +76,8 @@ pub enum SceneKind {
 pub struct SceneConfig {
     pub scene: SceneSection,
     pub fabric: FabricConfig,
+    /// The specimen (every kind but garments, whose cloth is their `[garment]` pattern).
+    #[serde(default)]
     pub cloth: ClothSection,
     pub mesh: MeshSection,
     pub solver: SolverSection,
@@ -86,6 +91,9 @@ pub struct SceneConfig {
     /// Rigid props: `[[props]]` tables.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub props: Vec<PropConfig>,
+    /// Garment scenes: the pattern, its seams and the form.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub garment: Option<crate::garment::GarmentConfig>,
     /// Directory of the scene file, for relative asset paths (none for bundled scenes).
     #[serde(skip)]
     pub base_dir: Option<PathBuf>,
@@ -258,7 +266,7 @@ impl<'de> Deserialize<'de> for FabricConfig {
     }
 }
 
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClothSection {
     /// Sample length along its x axis, m (the gauge length of a tensile test, the overhang

@@ -17,6 +17,7 @@ pub enum Rig {
     Euler(Euler),
     Shear(Shear),
     Drape(Drape),
+    Garment(Box<super::garment::rig::GarmentRig>),
 }
 
 pub struct Drape {
@@ -199,6 +200,7 @@ impl Rig {
                 let columns = Columns::new(&rest, length, h);
                 Rig::Euler(Euler { left, right, columns, width, length, history: Vec::new(), speed })
             }
+            SceneKind::Garment => return Err(SceneError::Setup("garment scenes build their own rig (scene::garment)".into())),
             SceneKind::ShearBuckling => {
                 let clamped = vertices_where(&rest, |p| p.y < ON_EDGE);
                 let moving = vertices_where(&rest, |p| p.y > width - ON_EDGE);
@@ -367,6 +369,7 @@ impl Rig {
                 })
             }
             Rig::Shear(r) => Measures::Shear(shear_measures(r, model, state)),
+            Rig::Garment(r) => Measures::Garment(r.finish(model, state)),
             Rig::Drape(r) => {
                 let (shadow, dc, nodes) = r.measure(model, state, 1024);
                 let radius_min = shadow.outline.iter().map(|o| o.1).fold(f64::INFINITY, f64::min);
@@ -389,6 +392,7 @@ impl Rig {
     pub fn outline(&self, model: &Model, state: &State) -> Option<Vec<(f64, f64)>> {
         match self {
             Rig::Drape(r) => Some(r.measure(model, state, 1024).0.outline),
+            Rig::Garment(r) => Some(r.outline(model, state)),
             _ => None,
         }
     }

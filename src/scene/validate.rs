@@ -17,15 +17,15 @@ pub struct Invalid {
     pub message: String,
 }
 
-fn invalid(key: &str, message: String) -> Invalid {
+pub(super) fn invalid(key: &str, message: String) -> Invalid {
     Invalid { key: key.to_string(), message }
 }
 
-fn positive(key: &str, v: f64) -> Result<f64, Invalid> {
+pub(super) fn positive(key: &str, v: f64) -> Result<f64, Invalid> {
     if v.is_finite() && v > 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be a positive number, got {v:?}"))) }
 }
 
-fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
+pub(super) fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
     if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be zero or a positive number, got {v:?}"))) }
 }
 
@@ -98,9 +98,13 @@ pub fn check_scene(c: &SceneConfig) -> Result<(), Invalid> {
     }
     check_solver(c)?;
     check_step_count("scene.duration", s.duration, c.solver.dt, s.max_steps)?;
-    let extent = check_cloth(c)?;
-    check_mesh(c, &extent)?;
-    let extent = extent.size;
+    let extent = if c.scene.kind == SceneKind::Garment {
+        super::garment::check(c)?
+    } else {
+        let extent = check_cloth(c)?;
+        check_mesh(c, &extent)?;
+        extent.size
+    };
     c.material().map_err(|e| invalid(&format!("fabric.{}", e.key()), e.to_string()))?;
     check_test(c, extent)?;
     check_contact(c, extent)?;
@@ -323,6 +327,11 @@ fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
             }
         }
         SceneKind::Cantilever | SceneKind::Drape => {}
+        SceneKind::Garment => {
+            if t.perturbation.is_some() {
+                return Err(invalid("test.perturbation", "test.perturbation has no effect on a garment scene (its panels start where their placement puts them); remove it".into()));
+            }
+        }
     }
     if let Some(v) = t.clamp_length {
         positive_at_most("test.clamp_length", v, length, "the strip's length, cloth.length")?;

@@ -2,6 +2,7 @@
 //! hinges that stiffen what the fits miss, the constant bending matrix Q, and nonlinear
 //! bending by a measured moment–curvature curve.
 
+use super::charts::{PanelCharts, Placement};
 use super::{Model, ModelError, PARALLEL_TRIANGLES, sorted_edge, sum_of, to_warp_frame};
 use crate::sim::curve::PiecewiseLinear;
 use crate::sim::linalg::ScalarCsr;
@@ -66,8 +67,17 @@ impl Model {
     /// Builds the bending stencils, Q and (for nonlinear bending) each triangle's share of
     /// Q, with `rigid` marking clamped vertices.
     pub(super) fn build_bending(&mut self, rigid: &[bool]) -> Result<(), ModelError> {
-        let mesh = Mesh { rest: self.rest.clone(), triangles: self.triangles.clone() };
-        let (patches, hinges) = bending_patches(&mesh, self.warp_angle, rigid)?;
+        let (patches, hinges) = match &self.frames {
+            None => {
+                let mesh = Mesh { rest: self.rest.clone(), triangles: self.triangles.clone() };
+                bending_patches(&mesh, self.warp_angle, rigid)?
+            }
+            Some(corners) => {
+                let areas: Vec<f64> = corners.iter().map(|c| 0.5 * (c[1] - c[0]).perp_dot(c[2] - c[0])).collect();
+                let rest = RestFrames::Panels { corners };
+                stencils(&self.triangles, self.rest.len(), &areas, &rest, self.mean_edge_length, rigid)?
+            }
+        };
         let (q, hinge_values) = bending_matrix(self.rest.len(), &patches, &hinges, &self.bending_stiffness);
         if let Some(nonlinear) = &mut self.bending_curve {
             nonlinear.contributions = triangle_contributions(&q, &patches, &self.bending_stiffness);
@@ -236,10 +246,40 @@ fn subtract_quadratic_force(q: &ScalarCsr, x: &[DVec3], f: &mut [DVec3]) {
 /// al.'s quadratic bending model). It is invariant to rigid motions, so the forces sum to
 /// zero and conserve momentum.
 pub(super) fn bending_patches(mesh: &Mesh, warp_angle: f64, rigid: &[bool]) -> Result<(Vec<BendingPatch>, Vec<Hinge>), ModelError> {
-    let n = mesh.rest.len();
+    let areas: Vec<f64> = (0..mesh.triangles.len()).map(|t| mesh.signed_area(t)).collect();
+    let warp: Vec<DVec2> = mesh.rest.iter().map(|&p| to_warp_frame(p, warp_angle)).collect();
+    stencils(&mesh.triangles, mesh.rest.len(), &areas, &RestFrames::Flat(warp), mesh.mean_edge_length(), rigid)
+}
+
+/// Where the stencils read rest positions.
+enum RestFrames<'a> {
+    /// One plane: every vertex's position in the warp frame.
+    Flat(Vec<DVec2>),
+    /// A cloth of panels: each triangle's corners in its own warp frame (see `charts`).
+    Panels { corners: &'a [[DVec2; 3]] },
+}
+
+/// The rest points an edge's fit and hinges read: the plane, or the edge's chart.
+enum EdgeFrame<'a> {
+    Flat(&'a [DVec2]),
+    Chart(super::charts::EdgeChart),
+}
+
+impl EdgeFrame<'_> {
+    fn point(&self, v: u32) -> Option<DVec2> {
+        match self {
+            EdgeFrame::Flat(warp) => Some(warp[v as usize]),
+            EdgeFrame::Chart(chart) => chart.points.get(&v).copied(),
+        }
+    }
+}
+
+/// [`bending_patches`] for any rest frames: `areas` are the triangles' rest areas (m²) and
+/// `scale` the mean rest edge length (m).
+fn stencils(triangles: &[[u32; 3]], n: usize, areas: &[f64], rest: &RestFrames, scale: f64, rigid: &[bool]) -> Result<(Vec<BendingPatch>, Vec<Hinge>), ModelError> {
     let mut edge_owner: HashMap<[u32; 2], Vec<(usize, usize)>> = HashMap::new();
     let mut vertex_triangles: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
+    for (t, tri) in triangles.iter().enumerate() {
         for k in 0..3 {
             edge_owner.entry(sorted_edge(tri[(k + 1) % 3], tri[(k + 2) % 3])).or_default().push((t, k));
             vertex_triangles[tri[k] as usize].push(t as u32);
@@ -250,38 +290,64 @@ pub(super) fn bending_patches(mesh: &Mesh, warp_angle: f64, rigid: &[bool]) -> R
             return Err(MeshError::NonManifold { a: edge[0], b: edge[1] }.into());
         }
     }
-    let warp: Vec<DVec2> = mesh.rest.iter().map(|&p| to_warp_frame(p, warp_angle)).collect();
-    let scale = mesh.mean_edge_length();
+    let charts = match rest {
+        RestFrames::Panels { corners } => Some(PanelCharts { triangles, corners, edge_owner: &edge_owner, reach: 4.5 * scale }),
+        RestFrames::Flat(_) => None,
+    };
+    let frame_of = |edge: [u32; 2], first: usize| match (rest, &charts) {
+        (RestFrames::Flat(warp), _) => EdgeFrame::Flat(warp),
+        (_, Some(charts)) => EdgeFrame::Chart(charts.unfold(first, edge)),
+        (RestFrames::Panels { .. }, None) => unreachable!("panels have charts"),
+    };
     // A clamped region moves rigidly: its curvature is zero while the cloth beside it bends,
     // so a fit across the clamp line would smear that jump and make the root too soft.
     // Edges inside the clamp (both ends rigid) fit rigid vertices only, which gives the
     // clamp's exact slope; other edges fit free vertices plus the clamp line itself.
-    let on_clamp_line: Vec<bool> = (0..n)
-        .map(|v| rigid[v] && vertex_triangles[v].iter().any(|&t| mesh.triangles[t as usize].iter().any(|&u| !rigid[u as usize])))
-        .collect();
-    // One gradient stencil per edge, shared by its triangles.
-    let mut gradient_of_edge: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
+    let on_clamp_line: Vec<bool> =
+        (0..n).map(|v| rigid[v] && vertex_triangles[v].iter().any(|&t| triangles[t as usize].iter().any(|&u| !rigid[u as usize]))).collect();
+    // One gradient stencil per edge, shared by its triangles (for panels, in the frame of
+    // the edge's first triangle, with the second triangle's placement in it), and the
+    // rest points of the edge's hinge quad.
+    let mut gradient_of_edge: HashMap<[u32; 2], (Vec<(u32, DVec2)>, Option<Placement>)> = HashMap::new();
+    let mut hinge_points: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
     for (&edge, owners) in &edge_owner {
-        let midpoint = 0.5 * (warp[edge[0] as usize] + warp[edge[1] as usize]);
+        let frame = frame_of(edge, owners[0].0);
+        let at = |v: u32| frame.point(v);
+        let midpoint = 0.5 * (at(edge[0]).expect("laid") + at(edge[1]).expect("laid"));
         let inside_clamp = rigid[edge[0] as usize] && rigid[edge[1] as usize];
-        let usable = |v: u32| if inside_clamp { rigid[v as usize] } else { !rigid[v as usize] || on_clamp_line[v as usize] };
-        let stencil = edge_gradient_stencil(mesh, &vertex_triangles, &warp, edge, midpoint, scale, usable)
+        let usable = |v: u32| at(v).is_some() && if inside_clamp { rigid[v as usize] } else { !rigid[v as usize] || on_clamp_line[v as usize] };
+        let stencil = edge_gradient_stencil(triangles, &vertex_triangles, &|v| at(v).expect("usable"), edge, midpoint, scale, usable)
             .ok_or(ModelError::SingularBendingStencil { triangle: owners[0].0 })?;
-        gradient_of_edge.insert(edge, stencil);
+        let second = match (&frame, owners.get(1)) {
+            (EdgeFrame::Chart(chart), Some(&(t1, _))) => Some(chart.placements[&t1]),
+            _ => None,
+        };
+        if let (EdgeFrame::Chart(_), [(t0, k0), (t1, k1)]) = (&frame, &owners[..]) {
+            let quad = [edge[0], edge[1], triangles[*t0][*k0], triangles[*t1][*k1]];
+            hinge_points.insert(edge, quad.iter().map(|&v| (v, at(v).expect("the edge's triangles are laid"))).collect());
+        }
+        gradient_of_edge.insert(edge, (stencil, second));
     }
-    let mut patches = Vec::with_capacity(mesh.triangles.len());
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let area = mesh.signed_area(t);
+    let mut patches = Vec::with_capacity(triangles.len());
+    for (t, tri) in triangles.iter().enumerate() {
+        let area = areas[t];
         let mut weights: Vec<(u32, [f64; 3])> = Vec::new();
         let mut interior = true;
         for k in 0..3 {
             let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
             let key = sorted_edge(a, b);
             interior &= edge_owner[&key].len() == 2;
-            let edge = warp[b as usize] - warp[a as usize];
+            let edge = match rest {
+                RestFrames::Flat(warp) => warp[b as usize] - warp[a as usize],
+                RestFrames::Panels { corners } => corners[t][(k + 2) % 3] - corners[t][(k + 1) % 3],
+            };
             // Outward normal times edge length, for a counter-clockwise triangle.
             let ln = DVec2::new(edge.y, -edge.x);
-            for &(v, c) in &gradient_of_edge[&key] {
+            let (stencil, second) = &gradient_of_edge[&key];
+            // The edge's second triangle reads the shared gradient in its own frame.
+            let turn = second.filter(|_| edge_owner[&key][0].0 != t);
+            for &(v, c) in stencil {
+                let c = turn.map_or(c, |p| p.to_own(c));
                 let w = [ln.x * c.x / area, ln.y * c.y / area, 0.5 * (ln.x * c.y + ln.y * c.x) / area];
                 match weights.iter_mut().find(|(u, _)| *u == v) {
                     Some((_, acc)) => (0..3).for_each(|i| acc[i] += w[i]),
@@ -299,9 +365,24 @@ pub(super) fn bending_patches(mesh: &Mesh, warp_angle: f64, rigid: &[bool]) -> R
     let mut hinges = Vec::new();
     for edge in edges {
         if let [(t0, k0), (t1, k1)] = edge_owner[&edge][..] {
-            let wings = [mesh.triangles[t0][k0], mesh.triangles[t1][k1]];
-            if !edge.iter().chain(&wings).any(|&v| rigid[v as usize]) {
-                hinges.extend([t0, t1].into_iter().filter_map(|t| Hinge::new(&patches[t], &warp, edge, wings)));
+            let wings = [triangles[t0][k0], triangles[t1][k1]];
+            if edge.iter().chain(&wings).any(|&v| rigid[v as usize]) {
+                continue;
+            }
+            for t in [t0, t1] {
+                let hinge = match rest {
+                    RestFrames::Flat(warp) => Hinge::new(&patches[t], &|v| warp[v as usize], edge, wings),
+                    RestFrames::Panels { .. } => {
+                        let quad = &hinge_points[&edge];
+                        let turn = gradient_of_edge[&edge].1.filter(|_| t == t1);
+                        let at = |v: u32| {
+                            let p = quad.iter().find(|(u, _)| *u == v).expect("a hinge reads its quad").1;
+                            turn.map_or(p, |placement| placement.point_to_own(p))
+                        };
+                        Hinge::new(&patches[t], &at, edge, wings)
+                    }
+                };
+                hinges.extend(hinge);
             }
         }
     }
@@ -346,8 +427,7 @@ pub(super) struct Hinge {
 impl Hinge {
     /// The half hinge of edge `e` between the triangles (e, wings[0]) and (e, wings[1]) on
     /// `patch`, the fitted Hessian of one of them; None if either triangle is degenerate.
-    fn new(patch: &BendingPatch, warp: &[DVec2], e: [u32; 2], wings: [u32; 2]) -> Option<Self> {
-        let p = |v: u32| warp[v as usize];
+    fn new(patch: &BendingPatch, p: &dyn Fn(u32) -> DVec2, e: [u32; 2], wings: [u32; 2]) -> Option<Self> {
         let along = p(e[1]) - p(e[0]);
         let mut normal = DVec2::new(along.y, -along.x).normalize();
         if (p(wings[1]) - p(e[0])).dot(normal) < 0.0 {
@@ -409,9 +489,9 @@ const HINGE_STABILIZATION: f64 = 1.0;
 /// quadratics. The neighbourhood grows ring by ring until the fit is well posed (near
 /// corners one ring lies on two lines, which no quadratic fit can resolve).
 fn edge_gradient_stencil(
-    mesh: &Mesh,
+    triangles: &[[u32; 3]],
     vertex_triangles: &[Vec<u32>],
-    warp: &[DVec2],
+    warp: &dyn Fn(u32) -> DVec2,
     edge: [u32; 2],
     midpoint: DVec2,
     scale: f64,
@@ -422,7 +502,7 @@ fn edge_gradient_stencil(
         let mut grown = points.clone();
         for &v in &points {
             for &t in &vertex_triangles[v as usize] {
-                grown.extend_from_slice(&mesh.triangles[t as usize]);
+                grown.extend_from_slice(&triangles[t as usize]);
             }
         }
         grown.retain(|&v| usable(v));
@@ -439,14 +519,14 @@ fn edge_gradient_stencil(
 /// Least-squares fit of f ≈ c0 + c1 u + c2 v + c3 u² + c4 uv + c5 v² with (u, v) the
 /// offsets from `midpoint` over `scale`, weighted towards near points; returns the weights
 /// of each point's value in (c1, c2)/scale. None if the fit is ill-posed.
-fn quadratic_gradient_weights(points: &[u32], warp: &[DVec2], midpoint: DVec2, scale: f64) -> Option<Vec<(u32, DVec2)>> {
+fn quadratic_gradient_weights(points: &[u32], warp: &dyn Fn(u32) -> DVec2, midpoint: DVec2, scale: f64) -> Option<Vec<(u32, DVec2)>> {
     if points.len() < 6 {
         return None;
     }
     let rows: Vec<([f64; 6], f64)> = points
         .iter()
         .map(|&v| {
-            let d = (warp[v as usize] - midpoint) / scale;
+            let d = (warp(v) - midpoint) / scale;
             // Near points count more, so the fit is as local as the data allow.
             let weight = 1.0 / (1.0 + d.length_squared());
             ([1.0, d.x, d.y, d.x * d.x, d.x * d.y, d.y * d.y], weight)

@@ -2,10 +2,9 @@
 //! the measured tensile curves ([`MembraneLaw`]), its forces as edge tensions and its
 //! Hessian in 3×3 blocks.
 
-use super::{Model, PARALLEL_TRIANGLES, outer, sum_of, to_warp_frame};
+use super::{Model, PARALLEL_TRIANGLES, outer, sum_of};
 use crate::sim::linalg::{BlockCsr, ScalarCsr};
 use crate::sim::material::MembraneLaw;
-use crate::sim::mesh::Mesh;
 use glam::{DMat3, DVec2, DVec3};
 
 /// Rest data of one triangle's strain rosette (paper Fig. 1).
@@ -16,6 +15,8 @@ pub(super) struct RosetteTriangle {
     area: f64,
     /// Rest length of edge k (opposite vertex k, from vertex k+1 to vertex k+2), m.
     rest_length: [f64; 3],
+    /// Unit direction of edge k at rest, in the warp frame.
+    rest_direction: [DVec2; 3],
     /// Maps the three edge strains to `[ε_xx, ε_yy, γ_xy]` in the warp frame.
     strain_from_edges: [[f64; 3]; 3],
     /// Slots in the stiffness matrix of block (vertex a, vertex b), row-major a·3+b.
@@ -127,6 +128,9 @@ impl Model {
     pub fn assemble_membrane_stiffness_within(&self, x: &[DVec3], k: &mut BlockCsr, compressed: CompressedEdges) {
         use rayon::prelude::*;
         k.clear();
+        if self.sewing.is_active() {
+            self.sewing.add_stiffness(k);
+        }
         let Some(law) = &self.membrane_law else { return };
         // Each vertex's scale for the compressed edges it ends (0: dropped).
         let ratio: Vec<f64> = match compressed {
@@ -170,10 +174,7 @@ impl Model {
         let c = law.tangent([0.0; 3]);
         for tri in &self.rosettes {
             let g = &tri.strain_from_edges;
-            let dirs: [DVec2; 3] = [0, 1, 2].map(|k| {
-                let (a, b) = edge_vertices(tri, k);
-                (self.rest[b as usize] - self.rest[a as usize]) / tri.rest_length[k]
-            });
+            let dirs = tri.rest_direction;
             let mut ke = [[0.0; 3]; 3];
             for p in 0..3 {
                 for q in 0..3 {
@@ -332,14 +333,17 @@ fn edge_tensions(tri: &RosetteTriangle, stress: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|k| tri.area * (g[0][k] * stress[0] + g[1][k] * stress[1] + g[2][k] * stress[2]) / tri.rest_length[k])
 }
 
-pub(super) fn rosette(mesh: &Mesh, t: usize, tri: [u32; 3], warp_angle: f64, pattern: &BlockCsr) -> RosetteTriangle {
-    let p = tri.map(|v| to_warp_frame(mesh.rest[v as usize], warp_angle));
+/// The rosette of triangle `tri` whose corners in its warp frame are `p` and whose rest area
+/// is `area` (m²).
+pub(super) fn rosette(p: [DVec2; 3], area: f64, tri: [u32; 3], pattern: &BlockCsr) -> RosetteTriangle {
     let mut rows = [[0.0; 3]; 3];
     let mut rest_length = [0.0; 3];
+    let mut rest_direction = [DVec2::ZERO; 3];
     for k in 0..3 {
         let d = p[(k + 2) % 3] - p[(k + 1) % 3];
         let l = d.length();
         rest_length[k] = l;
+        rest_direction[k] = d / l;
         let (c, s) = (d.x / l, d.y / l);
         // Strain gauge along the edge: ε_k = ε_xx c² + ε_yy s² + γ_xy c s.
         rows[k] = [c * c, s * s, c * s];
@@ -351,7 +355,7 @@ pub(super) fn rosette(mesh: &Mesh, t: usize, tri: [u32; 3], warp_angle: f64, pat
             slots[a * 3 + b] = pattern.slot(tri[a], tri[b]) as u32;
         }
     }
-    RosetteTriangle { vertices: tri, area: mesh.signed_area(t), rest_length, strain_from_edges, slots }
+    RosetteTriangle { vertices: tri, area, rest_length, rest_direction, strain_from_edges, slots }
 }
 
 fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {

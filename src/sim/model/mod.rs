@@ -6,14 +6,17 @@
 //! bending, gravity) is absent from the model, not multiplied by zero.
 
 mod bending;
+mod charts;
 mod membrane;
 mod motion;
+mod sewing;
 mod stability;
 #[cfg(test)]
 pub(crate) mod tests;
 
 pub use membrane::CompressedEdges;
 pub use motion::Motion;
+pub use sewing::{PanelSurface, Sewing};
 
 use crate::sim::contact::{Cloth, ContactModel};
 use crate::sim::linalg::{BlockCsr, ScalarCsr};
@@ -69,8 +72,17 @@ pub struct Model {
     pub mass: Vec<f64>,
     /// Lumped vertex areas, m² (a third of each adjacent triangle).
     pub vertex_area: Vec<f64>,
-    /// Warp direction in the sample plane, radians from the sample's x axis.
+    /// Warp direction in the sample plane, radians from the sample's x axis (zero for a
+    /// cloth of panels, whose triangles carry their own frames).
     pub warp_angle: f64,
+    /// A cloth of panels ([`Model::from_panels`]): each triangle's corners in its own warp
+    /// frame (x along the warp), m. None for a flat specimen, whose frame is `rest` turned
+    /// by `warp_angle`.
+    pub frames: Option<Vec<[DVec2; 3]>>,
+    /// Rest length of each of `edges` for a cloth of panels, m (None: from `rest`).
+    pub edge_rest_lengths: Option<Vec<f64>>,
+    /// Zero-length springs that close seams and hold attachments (empty unless sewn).
+    pub sewing: Sewing,
     pub mean_edge_length: f64,
     membrane_law: Option<MembraneLaw>,
     rosettes: Vec<RosetteTriangle>,
@@ -99,6 +111,16 @@ pub struct Model {
     pub max_wave_speed: f64,
 }
 
+/// The rest geometry a model is built from: per-vertex sample-plane positions (for a cloth
+/// of panels, the pattern coordinates drawn and exported), triangles, their rest areas and
+/// the mean rest edge length.
+struct RestGeometry<'a> {
+    rest: &'a [DVec2],
+    triangles: &'a [[u32; 3]],
+    areas: &'a [f64],
+    mean_edge_length: f64,
+}
+
 /// Rotates a sample-plane vector into the warp frame (x along the warp).
 fn to_warp_frame(p: DVec2, warp_angle: f64) -> DVec2 {
     DVec2::from_angle(-warp_angle).rotate(p)
@@ -109,32 +131,57 @@ impl Model {
     /// the sample's x axis.
     pub fn new(mesh: &Mesh, fabric: &Fabric, warp_angle: f64, options: PhysicsOptions) -> Result<Self, ModelError> {
         mesh.validate()?;
+        let areas: Vec<f64> = (0..mesh.triangles.len()).map(|t| mesh.signed_area(t)).collect();
+        let corners = |t: usize| mesh.triangles[t].map(|v| to_warp_frame(mesh.rest[v as usize], warp_angle));
+        let geometry = RestGeometry { rest: &mesh.rest, triangles: &mesh.triangles, areas: &areas, mean_edge_length: mesh.mean_edge_length() };
+        Self::build(geometry, corners, None, &[], fabric, warp_angle, options)
+    }
+
+    /// Builds a model of a cloth of flat panels (a garment): each triangle keeps its own
+    /// rest shape and warp frame (`surface.corners`), so that panels cut on different grains
+    /// and joined along seams are one surface. `seam_pairs` are the vertex pairs sewing
+    /// springs may join (their stiffness starts at zero; see [`Sewing`]).
+    pub fn from_panels(surface: &PanelSurface, seam_pairs: &[[u32; 2]], fabric: &Fabric, options: PhysicsOptions) -> Result<Self, ModelError> {
+        surface.validate()?;
+        let areas: Vec<f64> = surface.corners.iter().map(|c| 0.5 * (c[1] - c[0]).perp_dot(c[2] - c[0])).collect();
+        let geometry = RestGeometry { rest: &surface.pattern, triangles: &surface.triangles, areas: &areas, mean_edge_length: surface.mean_edge_length() };
+        let mut model = Self::build(geometry, |t| surface.corners[t], Some(surface.corners.clone()), seam_pairs, fabric, 0.0, options)?;
+        model.edge_rest_lengths = Some(surface.edge_rest_lengths(&model.edges));
+        model.sewing.pairs = seam_pairs.to_vec();
+        Ok(model)
+    }
+
+    fn build(
+        geometry: RestGeometry,
+        corners: impl Fn(usize) -> [DVec2; 3],
+        frames: Option<Vec<[DVec2; 3]>>,
+        extra_pairs: &[[u32; 2]],
+        fabric: &Fabric,
+        warp_angle: f64,
+        options: PhysicsOptions,
+    ) -> Result<Self, ModelError> {
         fabric.validate()?;
         if !(options.damping >= 0.0 && options.damping.is_finite()) {
             return Err(ModelError::BadDamping(options.damping));
         }
-        let n = mesh.rest.len();
+        let RestGeometry { rest, triangles, areas, mean_edge_length } = geometry;
+        let n = rest.len();
         let mut vertex_area = vec![0.0; n];
-        for (t, tri) in mesh.triangles.iter().enumerate() {
-            let a = mesh.signed_area(t);
+        for (tri, &a) in triangles.iter().zip(areas) {
             for &v in tri {
                 vertex_area[v as usize] += a / 3.0;
             }
         }
         let mass = vertex_area.iter().map(|a| a * fabric.areal_density).collect();
         let mut edge_set: Vec<[u32; 2]> =
-            mesh.triangles.iter().flat_map(|t| (0..3).map(move |k| sorted_edge(t[(k + 1) % 3], t[(k + 2) % 3]))).collect();
+            triangles.iter().flat_map(|t| (0..3).map(move |k| sorted_edge(t[(k + 1) % 3], t[(k + 2) % 3]))).collect();
         edge_set.sort_unstable();
         edge_set.dedup();
 
-        let stiffness_pattern = BlockCsr::with_pattern(n, edge_set.iter().map(|e| (e[0], e[1])));
+        let stiffness_pattern = BlockCsr::with_pattern(n, edge_set.iter().chain(extra_pairs).map(|e| (e[0], e[1])));
         let membrane_law = if options.membrane { Some(MembraneLaw::new(fabric)?) } else { None };
         let rosettes = if options.membrane {
-            mesh.triangles
-                .iter()
-                .enumerate()
-                .map(|(t, tri)| rosette(mesh, t, *tri, warp_angle, &stiffness_pattern))
-                .collect()
+            triangles.iter().enumerate().map(|(t, tri)| rosette(corners(t), areas[t], *tri, &stiffness_pattern)).collect()
         } else {
             Vec::new()
         };
@@ -147,12 +194,15 @@ impl Model {
             .map(NonlinearBending::new);
         let mut model = Self {
             options,
-            rest: mesh.rest.clone(),
-            triangles: mesh.triangles.clone(),
+            rest: rest.to_vec(),
+            triangles: triangles.to_vec(),
             mass,
             vertex_area,
             warp_angle,
-            mean_edge_length: mesh.mean_edge_length(),
+            frames,
+            edge_rest_lengths: None,
+            sewing: Sewing::default(),
+            mean_edge_length,
             membrane_law,
             rosettes,
             bending_stiffness,
@@ -202,6 +252,9 @@ impl Model {
     pub fn potential_energy(&self, x: &[DVec3]) -> f64 {
         let mut energy = self.membrane_energy(x);
         energy += self.bending_energy(x);
+        if self.sewing.is_active() {
+            energy += self.sewing.energy(x);
+        }
         if self.options.gravity != DVec3::ZERO {
             let g = self.options.gravity;
             energy -= sum_of(x.len(), |i| self.mass[i] * g.dot(x[i]));
@@ -224,6 +277,9 @@ impl Model {
         }
         self.add_membrane_forces(x, f);
         self.add_bending_forces(x, f);
+        if self.sewing.is_active() {
+            self.sewing.add_forces(x, f);
+        }
     }
 
     /// Total conservative force −∇E into `f` (overwritten) and the potential energy E, J, from

@@ -22,8 +22,12 @@ impl Model {
     pub fn max_stretch(&self, x: &[DVec3]) -> f64 {
         self.edges
             .iter()
-            .map(|&[a, b]| {
-                let rest = (self.rest[a as usize] - self.rest[b as usize]).length();
+            .enumerate()
+            .map(|(i, &[a, b])| {
+                let rest = match &self.edge_rest_lengths {
+                    Some(lengths) => lengths[i],
+                    None => (self.rest[a as usize] - self.rest[b as usize]).length(),
+                };
                 (x[a as usize] - x[b as usize]).length() / rest
             })
             .fold(0.0, f64::max)

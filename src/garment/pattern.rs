@@ -1,0 +1,282 @@
+//! Pattern pieces as a designer draws them: closed outlines of named edges (straight
+//! lines, circular arcs through a point, cubic Bézier curves) in the panel's own plane,
+//! each panel with its grain line and its place around the form.
+
+use super::GarmentError;
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+/// The unit of every length in a garment section.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Units {
+    /// Centimetres, as pattern makers draw (the default).
+    #[default]
+    Cm,
+    /// Metres, as the rest of Rosette's files.
+    M,
+}
+
+impl Units {
+    /// Metres per unit.
+    pub fn metres(self) -> f64 {
+        match self {
+            Units::Cm => 0.01,
+            Units::M => 1.0,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Units::Cm => "cm",
+            Units::M => "m",
+        }
+    }
+}
+
+/// One edge of an outline, from the end of the previous edge (or the panel's `start`) to
+/// `to`: straight, an arc through `through`, or a cubic Bézier with `controls`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EdgeConfig {
+    /// Unique within the panel: seams and attachments name it as `panel.edge`.
+    pub name: String,
+    /// End point, in the garment's units.
+    pub to: [f64; 2],
+    /// A circular arc through this point (neither first nor last point).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub through: Option<[f64; 2]>,
+    /// A cubic Bézier curve with these two control points.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controls: Option<[[f64; 2]; 2]>,
+}
+
+/// How a panel starts around the form (the arrangement point of CLO and Marvelous).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Around {
+    /// Wrapped without stretch onto a cone around the form's axis whose side leans out by
+    /// `flare_deg` from the vertical: 0 is an upright cylinder (a straight skirt's panels),
+    /// a few degrees an A-line's, 90 a flat ring in the horizontal plane (a circle skirt).
+    Cone,
+    /// Flat in the vertical plane `distance` from the axis, facing out.
+    Plane,
+}
+
+/// Where a panel starts.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlacementConfig {
+    pub around: Around,
+    /// Direction from the form's axis to the panel's anchor, degrees counter-clockwise
+    /// from +x seen from above (the form faces −y: 270 is the front, 90 the back).
+    pub angle_deg: f64,
+    /// Distance of the anchor from the form's axis, in the garment's units.
+    pub distance: f64,
+    /// Height of the anchor above the floor, in the garment's units.
+    pub height: f64,
+    /// Cone: how far its side leans out from the vertical, degrees (0 to 90).
+    #[serde(default)]
+    pub flare_deg: f64,
+}
+
+/// One pattern piece.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PanelConfig {
+    pub name: String,
+    /// The warp (straight grain) direction, degrees counter-clockwise from the panel's x
+    /// axis: 90 runs the warp up and down a panel drawn upright (straight grain), 45 or 135
+    /// cuts it on the bias.
+    pub grain_deg: f64,
+    /// First point of the outline, in the garment's units.
+    pub start: [f64; 2],
+    /// The outline's edges, counter-clockwise seen from the right side of the fabric
+    /// (outside the garment); the last ends at `start`.
+    pub edges: Vec<EdgeConfig>,
+    /// The panel point placed at the arrangement point (default: the middle of the top of
+    /// its bounding box), in the garment's units.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anchor: Option<[f64; 2]>,
+    pub placement: PlacementConfig,
+}
+
+/// A sampled curve: points from start to end with their arc lengths.
+#[derive(Debug, Clone)]
+pub struct Polyline {
+    pub points: Vec<DVec2>,
+    /// Arc length at each point, m.
+    pub arc: Vec<f64>,
+}
+
+impl Polyline {
+    fn new(points: Vec<DVec2>) -> Self {
+        let mut arc = vec![0.0];
+        for w in points.windows(2) {
+            arc.push(arc.last().unwrap() + w[0].distance(w[1]));
+        }
+        Self { points, arc }
+    }
+
+    pub fn length(&self) -> f64 {
+        *self.arc.last().unwrap()
+    }
+
+    /// The point at arc length `s` (clamped to the curve).
+    pub fn at(&self, s: f64) -> DVec2 {
+        let i = self.arc.partition_point(|&a| a < s).clamp(1, self.points.len() - 1);
+        let (a0, a1) = (self.arc[i - 1], self.arc[i]);
+        let t = if a1 > a0 { ((s - a0) / (a1 - a0)).clamp(0.0, 1.0) } else { 0.0 };
+        self.points[i - 1].lerp(self.points[i], t)
+    }
+}
+
+/// Points per edge when an outline is sampled: dense enough that the chord of a curve
+/// differs from the curve by far less than any mesh edge.
+const SAMPLES: usize = 256;
+
+/// A finite point in metres, or an error naming the panel and the key.
+fn point(panel: &str, key: &str, p: [f64; 2], metres: f64) -> Result<DVec2, GarmentError> {
+    if p.iter().all(|c| c.is_finite() && c.abs() < 1e5) {
+        Ok(DVec2::from_array(p) * metres)
+    } else {
+        Err(GarmentError::new(format!("garment.panels '{panel}': {key} = {p:?} must be two finite coordinates")))
+    }
+}
+
+impl PanelConfig {
+    /// Each edge sampled densely, in metres, in the panel's own plane.
+    pub fn curves(&self, metres: f64) -> Result<Vec<Polyline>, GarmentError> {
+        let name = &self.name;
+        if self.edges.len() < 2 {
+            return Err(GarmentError::new(format!("garment.panels '{name}': an outline needs at least two edges (a closed shape)")));
+        }
+        let mut from = point(name, "start", self.start, metres)?;
+        let mut curves = Vec::with_capacity(self.edges.len());
+        for e in &self.edges {
+            let key = format!("edge '{}'", e.name);
+            let to = point(name, &format!("{key}: to"), e.to, metres)?;
+            let points = match (e.through, e.controls) {
+                (Some(_), Some(_)) => {
+                    return Err(GarmentError::new(format!("garment.panels '{name}': {key} gives both `through` (an arc) and `controls` (a Bézier curve); keep one")));
+                }
+                (Some(through), None) => arc_through(from, point(name, &format!("{key}: through"), through, metres)?, to)
+                    .ok_or_else(|| GarmentError::new(format!("garment.panels '{name}': {key}: the arc's three points lie on a line; drop `through` for a straight edge")))?,
+                (None, Some([c1, c2])) => bezier(from, point(name, &format!("{key}: controls"), c1, metres)?, point(name, &format!("{key}: controls"), c2, metres)?, to),
+                (None, None) => (0..=SAMPLES).map(|i| from.lerp(to, i as f64 / SAMPLES as f64)).collect(),
+            };
+            let line = Polyline::new(points);
+            if line.length() <= 1e-6 {
+                return Err(GarmentError::new(format!("garment.panels '{name}': {key} has no length; remove it or move its end point")));
+            }
+            curves.push(line);
+            from = to;
+        }
+        if from.distance(point(name, "start", self.start, metres)?) > 1e-9 {
+            return Err(GarmentError::new(format!(
+                "garment.panels '{name}': the last edge '{}' must end at start = {:?} to close the outline",
+                self.edges.last().unwrap().name,
+                self.start
+            )));
+        }
+        Ok(curves)
+    }
+}
+
+/// The circular arc from `a` through `b` to `c`, sampled; None when the points are collinear.
+fn arc_through(a: DVec2, b: DVec2, c: DVec2) -> Option<Vec<DVec2>> {
+    let d = 2.0 * (a.x * (b.y - c.y) + b.x * (c.y - a.y) + c.x * (a.y - b.y));
+    if d.abs() < 1e-12 * (a.distance_squared(c) + 1e-30) {
+        return None;
+    }
+    let sq = |p: DVec2| p.length_squared();
+    let centre = DVec2::new(
+        (sq(a) * (b.y - c.y) + sq(b) * (c.y - a.y) + sq(c) * (a.y - b.y)) / d,
+        (sq(a) * (c.x - b.x) + sq(b) * (a.x - c.x) + sq(c) * (b.x - a.x)) / d,
+    );
+    let angle = |p: DVec2| (p - centre).to_angle();
+    let (t0, tb, tc) = (angle(a), angle(b), angle(c));
+    // Sweep from a to c the way that passes b.
+    let ccw = |t: f64| (t - t0).rem_euclid(std::f64::consts::TAU);
+    let sweep = if ccw(tb) <= ccw(tc) { ccw(tc) } else { ccw(tc) - std::f64::consts::TAU };
+    let radius = a.distance(centre);
+    let mut points: Vec<DVec2> = (0..=SAMPLES).map(|i| centre + radius * DVec2::from_angle(t0 + sweep * i as f64 / SAMPLES as f64)).collect();
+    // The ends exactly where they were given.
+    points[0] = a;
+    points[SAMPLES] = c;
+    Some(points)
+}
+
+fn bezier(p0: DVec2, p1: DVec2, p2: DVec2, p3: DVec2) -> Vec<DVec2> {
+    (0..=SAMPLES)
+        .map(|i| {
+            let t = i as f64 / SAMPLES as f64;
+            let u = 1.0 - t;
+            u * u * u * p0 + 3.0 * u * u * t * p1 + 3.0 * u * t * t * p2 + t * t * t * p3
+        })
+        .collect()
+}
+
+/// Refuses an outline that crosses itself, naming the panel and the two edges.
+pub fn check_simple(panel: &str, names: &[&str], curves: &[Polyline]) -> Result<(), GarmentError> {
+    // Every segment with its edge; segments that share an end point (neighbours along the
+    // outline) are not tested against each other.
+    let segments: Vec<(usize, DVec2, DVec2)> = curves.iter().enumerate().flat_map(|(e, c)| c.points.windows(2).map(move |w| (e, w[0], w[1]))).collect();
+    let n = segments.len();
+    for i in 0..n {
+        for j in i + 2..n {
+            if i == 0 && j == n - 1 {
+                continue;
+            }
+            let (ei, a, b) = segments[i];
+            let (ej, c, d) = segments[j];
+            if segments_cross(a, b, c, d) {
+                return Err(GarmentError::new(format!(
+                    "garment.panels '{panel}': the outline crosses itself where edge '{}' meets edge '{}'; a panel must be a simple closed shape",
+                    names[ei], names[ej]
+                )));
+            }
+        }
+    }
+    let area: f64 = curves.iter().flat_map(|c| c.points.windows(2)).map(|w| 0.5 * w[0].perp_dot(w[1])).sum();
+    if area <= 0.0 {
+        return Err(GarmentError::new(format!(
+            "garment.panels '{panel}': the outline runs clockwise; list its edges counter-clockwise as seen from the right side of the fabric"
+        )));
+    }
+    Ok(())
+}
+
+/// Whether segments ab and cd intersect (touching included).
+fn segments_cross(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
+    let orient = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+    let (d1, d2, d3, d4) = (orient(c, d, a), orient(c, d, b), orient(a, b, c), orient(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
+        return true;
+    }
+    let on = |p: DVec2, q: DVec2, r: DVec2| orient(p, q, r).abs() < 1e-15 && r.cmpge(p.min(q)).all() && r.cmple(p.max(q)).all();
+    on(c, d, a) || on(c, d, b) || on(a, b, c) || on(a, b, d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arc_through_a_point_has_the_circle_length() {
+        let arc = Polyline::new(arc_through(DVec2::new(1.0, 0.0), DVec2::new(0.0, 1.0), DVec2::new(-1.0, 0.0)).unwrap());
+        assert!((arc.length() - std::f64::consts::PI).abs() < 1e-4, "{}", arc.length());
+        // The other way round, through the lower half.
+        let arc = Polyline::new(arc_through(DVec2::new(1.0, 0.0), DVec2::new(0.0, -1.0), DVec2::new(-1.0, 0.0)).unwrap());
+        assert!(arc.points[SAMPLES / 2].y < -0.99);
+    }
+
+    #[test]
+    fn a_bowtie_is_refused_naming_its_edges() {
+        let p = |x: f64, y: f64| DVec2::new(x, y);
+        let line = |a: DVec2, b: DVec2| Polyline::new(vec![a, b]);
+        let curves = vec![line(p(0.0, 0.0), p(1.0, 1.0)), line(p(1.0, 1.0), p(1.0, 0.0)), line(p(1.0, 0.0), p(0.0, 1.0)), line(p(0.0, 1.0), p(0.0, 0.0))];
+        let err = check_simple("front", &["a", "b", "c", "d"], &curves).unwrap_err().to_string();
+        assert!(err.contains("front") && err.contains("'a'") && err.contains("'c'"), "{err}");
+    }
+}

@@ -1,0 +1,374 @@
+//! Garment scenes: the pattern built around its form, sewn by springs that grow until
+//! every seam is closed, then welded into one surface that drapes on the form.
+//!
+//! ```text
+//!   build: panels meshed and placed, the form as a mesh prop, the welded model made
+//!          up front (so a pattern that cannot be welded is refused before any work)
+//!   sew:   springs k(t) = k·min(t/ramp, 1) pull seam pairs together and attached edges
+//!          onto the form; self-collision off (the seam's two sides must meet)
+//!   weld:  once every pair is within `closed_share` of the contact thickness: pairs
+//!          merged, the welded model takes over (membrane and bending across the seams),
+//!          attached vertices pinned where they are, self-collision on
+//! ```
+
+pub mod rig;
+
+use super::preset::SceneConfig;
+use super::{Scene, SceneError, levels};
+use crate::garment::{self, Garment, form};
+use crate::sim::contact::{ContactModel, ContactSettings, Prop, PropShape};
+use crate::sim::model::PanelSurface;
+use crate::sim::{Model, PhysicsOptions, State};
+use glam::{DQuat, DVec2, DVec3};
+
+/// Sewing in progress or done.
+pub struct Sewing {
+    /// The seams' final spring stiffness (N/m), its ramp (s) and the time by which the
+    /// seams must be closed (s).
+    stiffness: f64,
+    ramp: f64,
+    deadline: f64,
+    /// A seam is closed when its pairs are this close, m.
+    closed_gap: f64,
+    /// Air damping while sewing, and the scene's from the weld on, 1/s.
+    damping: (f64, f64),
+    /// The welded cloth's model, built with the scene; taken at the weld.
+    welded: Option<Model>,
+    /// For each vertex of the unsewn cloth, its vertex in the welded one.
+    weld_map: Vec<u32>,
+    /// Vertices pinned once the garment is sewn (attached ones), unsewn numbering.
+    pin_after: Vec<u32>,
+    /// Self-collision as the scene asks for it, on from the weld.
+    self_collision: bool,
+    /// When the seams were welded, and the largest gap then, m.
+    pub sewn_at: Option<f64>,
+    pub gap_at_weld: Option<f64>,
+}
+
+impl Sewing {
+    /// Whether the garment is sewn (welded).
+    pub fn is_sewn(&self) -> bool {
+        self.sewn_at.is_some()
+    }
+
+    /// Whether the sewing time has passed with a seam still open.
+    pub fn failed(&self, time: f64) -> bool {
+        !self.is_sewn() && time > self.deadline
+    }
+}
+
+/// The parts `Scene::build_level` assembles for a garment.
+pub struct Parts {
+    pub model: Model,
+    pub x: Vec<DVec3>,
+    pub props: Vec<Prop>,
+    pub rig: rig::GarmentRig,
+    pub sewing: Sewing,
+}
+
+/// The dress form as a prop, and the height of its named levels (none for an OBJ body).
+pub fn build_form(config: &SceneConfig) -> Result<(Prop, Option<form::Measurements>), SceneError> {
+    let g = config.garment.as_ref().ok_or_else(|| SceneError::Setup("a garment scene needs a [garment] section".into()))?;
+    let metres = g.units.metres();
+    let axis = DVec3::new(g.form.axis[0] * metres, g.form.axis[1] * metres, 0.0);
+    let measurements = g.form.measurements(g.units).map_err(|e| SceneError::Setup(e.to_string()))?;
+    let shape = match (&measurements, &g.form.obj) {
+        (Some(m), _) => {
+            let (vertices, triangles) = form::form_mesh(m);
+            PropShape::Mesh { vertices, triangles }
+        }
+        (None, Some(file)) => {
+            let scale = g.form.scale.unwrap_or(1.0);
+            let (vertices, triangles) = super::props::load_obj(file, config.base_dir.as_deref(), scale).map_err(|e| SceneError::Setup(format!("garment.form.obj: {e}")))?;
+            PropShape::Mesh { vertices: vertices.into_iter().map(|v| v * scale).collect(), triangles }
+        }
+        (None, None) => return Err(SceneError::Setup("garment.form: give size, measurements or obj".into())),
+    };
+    let prop = Prop::new("form", shape, axis, DQuat::IDENTITY).map_err(|e| SceneError::Setup(e.to_string()))?;
+    Ok((prop, measurements))
+}
+
+/// Builds a garment scene's model, start, props, rig and sewing.
+pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: PhysicsOptions) -> Result<Parts, SceneError> {
+    let g = config.garment.as_ref().ok_or_else(|| SceneError::Setup("a garment scene needs a [garment] section".into()))?;
+    let metres = g.units.metres();
+    let (form, measurements) = build_form(config)?;
+    let axis = DVec2::new(g.form.axis[0], g.form.axis[1]) * metres;
+    let level = |name: &str| {
+        let m = measurements.as_ref()?;
+        match name {
+            "waist" => Some(m.waist_height),
+            "hip" => Some(m.hip_height),
+            "bust" => Some(m.bust_height),
+            _ => None,
+        }
+    };
+    let garment = garment::build(g, config.mesh.edge_length, axis, &level).map_err(|e| SceneError::Setup(e.to_string()))?;
+    let thickness = config.contact.thickness;
+    check_outside(&garment, &form, thickness)?;
+    let pairs = garment.seam_pairs();
+    let mut model = Model::from_panels(&garment.surface, &pairs, fabric, options)?;
+    let x = garment.positions.clone();
+    for &v in &garment.pinned {
+        model.pin(v, x[v as usize]);
+    }
+    model.sewing.anchors = anchors(&garment, &form, axis, thickness);
+    let (welded_surface, weld_map) = weld_surface(&garment.surface, &pairs);
+    let mut welded = Model::from_panels(&welded_surface, &[], fabric, options)?;
+    let mut props = super::props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
+    props.insert(0, form);
+    let settings = ContactSettings { relative_motion: config.solver.path == levels::SolverPath::Fast, ..config.contact };
+    welded.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
+    model.contact = Some(ContactModel::new(props.clone(), ContactSettings { self_collision: false, ..settings }).map_err(SceneError::Setup)?);
+    let pin_after: Vec<u32> = model.sewing.anchors.iter().map(|a| a.0).collect();
+    let sewing = Sewing {
+        stiffness: g.sewing_stiffness,
+        ramp: g.sewing_ramp,
+        deadline: g.sewing_time,
+        closed_gap: g.closed_share * thickness,
+        damping: (g.sewing_damping, config.solver.damping),
+        welded: Some(welded),
+        weld_map,
+        pin_after,
+        self_collision: config.contact.self_collision,
+        sewn_at: None,
+        gap_at_weld: None,
+    };
+    let rig = rig::GarmentRig::new(&garment, &props[0], measurements.as_ref(), config);
+    Ok(Parts { model, x, props, rig, sewing })
+}
+
+/// The checks a garment scene passes when it is loaded (`validate::check_scene`): the
+/// `[garment]` section, no `[cloth]` keys, the sewing settings, and the pattern itself
+/// (outlines, grains, seams, attachments, meshing). Returns the smallest panel's smaller
+/// side, m.
+pub fn check(c: &SceneConfig) -> Result<f64, super::validate::Invalid> {
+    use super::validate::{invalid, positive};
+    let g = c.garment.as_ref().ok_or_else(|| invalid("garment", "a garment scene needs a [garment] section with its panels and form".into()))?;
+    let cloth = &c.cloth;
+    if cloth.length != 0.0 || cloth.width != 0.0 || cloth.diameter != 0.0 || cloth.warp_angle_deg != 0.0 || cloth.position != [0.0; 3] {
+        return Err(invalid("cloth", "a garment's cloth is its [garment] pattern; remove the [cloth] section (each panel has its own grain_deg and placement)".into()));
+    }
+    let h = positive("mesh.edge_length", c.mesh.edge_length)?;
+    positive("garment.sewing_stiffness", g.sewing_stiffness)?;
+    positive("garment.sewing_ramp", g.sewing_ramp)?;
+    positive("garment.sewing_time", g.sewing_time)?;
+    positive("garment.closed_share", g.closed_share)?;
+    super::validate::non_negative("garment.sewing_damping", g.sewing_damping)?;
+    if g.sewing_time > c.scene.duration {
+        return Err(invalid("garment.sewing_time", format!("garment.sewing_time = {} s is longer than scene.duration = {} s", g.sewing_time, c.scene.duration)));
+    }
+    let measurements = g.form.measurements(g.units).map_err(|e| invalid("garment.form", e.to_string()))?;
+    let level = |name: &str| {
+        let m = measurements.as_ref()?;
+        match name {
+            "waist" => Some(m.waist_height),
+            "hip" => Some(m.hip_height),
+            "bust" => Some(m.bust_height),
+            _ => None,
+        }
+    };
+    let metres = g.units.metres();
+    let garment = garment::build(g, h, DVec2::from_array(g.form.axis) * metres, &level).map_err(|e| invalid("garment", e.to_string()))?;
+    let extent = garment
+        .meshes
+        .iter()
+        .map(|m| {
+            let (lo, hi) = m.points.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+            (hi - lo).min_element()
+        })
+        .fold(f64::INFINITY, f64::min);
+    if h > 0.5 * extent {
+        return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {h} m leaves fewer than 2 elements across the smallest panel ({extent:.3} m); use at most {:.4}", 0.5 * extent)));
+    }
+    Ok(extent)
+}
+
+/// Refuses a panel that starts inside the form (or within its contact layer).
+fn check_outside(garment: &Garment, form: &Prop, thickness: f64) -> Result<(), SceneError> {
+    for (p, (name, _)) in garment.names.iter().enumerate() {
+        let end = garment.offsets.get(p + 1).copied().unwrap_or(garment.positions.len() as u32);
+        for v in garment.offsets[p]..end {
+            let x = garment.positions[v as usize];
+            if form.surface_point(x).distance < thickness {
+                return Err(SceneError::Setup(format!(
+                    "garment.panels '{name}': starts inside the form (its point at {:.3?} m is {:.1} mm from the form's surface, within the {:.1} mm contact layer); \
+                     place it farther out (placement.distance) or higher",
+                    x.to_array(),
+                    1e3 * form.surface_point(x).distance,
+                    1e3 * thickness
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The form's horizontal section at height `z`: `count` points found by rays from outside
+/// towards the axis, each pushed out by `offset` (m).
+pub fn section(form: &Prop, axis: DVec2, z: f64, count: usize, offset: f64) -> Vec<DVec3> {
+    (0..count)
+        .filter_map(|k| {
+            let dir = DVec2::from_angle(std::f64::consts::TAU * k as f64 / count as f64);
+            let centre = DVec3::new(axis.x, axis.y, z);
+            let outside = centre + 3.0 * DVec3::new(dir.x, dir.y, 0.0);
+            form.segment_entry(outside, centre).map(|hit| hit.point + offset * DVec3::new(dir.x, dir.y, 0.0))
+        })
+        .collect()
+}
+
+/// Where each attached vertex is pulled: onto the form's section at its height, pushed out
+/// by 1.5 contact thicknesses. The edges attached at one height share that section in
+/// proportion to their lengths, each centred where it starts and running the way it runs
+/// around the axis, so that a waist of the form's girth goes on without stretch.
+fn anchors(garment: &Garment, form: &Prop, axis: DVec2, thickness: f64) -> Vec<(u32, DVec3)> {
+    let mut heights: Vec<f64> = garment.attached_edges.iter().map(|&(_, z)| z).collect();
+    heights.sort_by(f64::total_cmp);
+    heights.dedup();
+    let angle_of = |v: u32| {
+        let p = garment.positions[v as usize];
+        (p.y - axis.y).atan2(p.x - axis.x)
+    };
+    let mut out = Vec::new();
+    for z in heights {
+        let ring = section(form, axis, z, 720, 1.5 * thickness);
+        if ring.len() < 3 {
+            continue;
+        }
+        let arc: Vec<f64> = std::iter::once(0.0).chain(ring.iter().zip(ring.iter().cycle().skip(1)).scan(0.0, |s, (a, b)| {
+            *s += a.distance(*b);
+            Some(*s)
+        })).collect();
+        let girth = *arc.last().unwrap();
+        let at = |s: f64| {
+            let s = s.rem_euclid(girth);
+            let i = arc.partition_point(|&a| a <= s).clamp(1, ring.len());
+            let t = (s - arc[i - 1]) / (arc[i] - arc[i - 1]).max(1e-12);
+            ring[i - 1].lerp(ring[i % ring.len()], t)
+        };
+        // Arc length on the section at the ray nearest an angle.
+        let arc_at = |angle: f64| arc[((angle.rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU * ring.len() as f64).round() as usize) % ring.len()];
+        let edges: Vec<&Vec<u32>> = garment.attached_edges.iter().filter(|(_, h)| *h == z).map(|(e, _)| e).collect();
+        let rest = |e: &[u32]| -> Vec<f64> {
+            std::iter::once(0.0).chain(e.windows(2).scan(0.0, |s, w| {
+                *s += garment.surface.pattern[w[0] as usize].distance(garment.surface.pattern[w[1] as usize]);
+                Some(*s)
+            })).collect()
+        };
+        let total: f64 = edges.iter().map(|e| *rest(e).last().unwrap()).sum();
+        for e in edges {
+            let s = rest(e);
+            let length = *s.last().unwrap();
+            let mid = e[s.partition_point(|&a| a < 0.5 * length).min(e.len() - 1)];
+            let turn = (angle_of(*e.last().unwrap()) - angle_of(e[0]) + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+            let centre = arc_at(angle_of(mid));
+            for (v, si) in e.iter().zip(&s) {
+                out.push((*v, at(centre + turn.signum() * (si - 0.5 * length) * girth / total)));
+            }
+        }
+    }
+    out
+}
+
+/// The cloth with every seam pair merged: the welded surface and each old vertex's new index.
+fn weld_surface(surface: &PanelSurface, pairs: &[[u32; 2]]) -> (PanelSurface, Vec<u32>) {
+    let n = surface.pattern.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], v: u32) -> u32 {
+        let mut r = v;
+        while parent[r as usize] != r {
+            r = parent[r as usize];
+        }
+        let mut v = v;
+        while parent[v as usize] != r {
+            let next = parent[v as usize];
+            parent[v as usize] = r;
+            v = next;
+        }
+        r
+    }
+    for &[a, b] in pairs {
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        if ra != rb {
+            parent[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+    let mut new_index = vec![u32::MAX; n];
+    let mut map = vec![0u32; n];
+    let mut pattern = Vec::new();
+    for v in 0..n as u32 {
+        let r = root(&mut parent, v) as usize;
+        if new_index[r] == u32::MAX {
+            new_index[r] = pattern.len() as u32;
+            pattern.push(surface.pattern[r]);
+        }
+        map[v as usize] = new_index[r];
+    }
+    let triangles = surface.triangles.iter().map(|t| t.map(|v| map[v as usize])).collect();
+    (PanelSurface { triangles, corners: surface.corners.clone(), pattern }, map)
+}
+
+impl Scene {
+    /// Before a step of a garment still being sewn: the springs' stiffness at the step's
+    /// end time.
+    pub(super) fn sew_before_step(&mut self) {
+        let Some(sewing) = &self.garment else { return };
+        if sewing.is_sewn() {
+            return;
+        }
+        let t = self.state.time + self.integrator.dt;
+        self.model.sewing.stiffness = sewing.stiffness * (t / sewing.ramp).min(1.0);
+        self.model.options.damping = sewing.damping.0;
+    }
+
+    /// After a step: welds the garment once every seam and attachment is closed.
+    pub(super) fn sew_after_step(&mut self) {
+        let Some(sewing) = &mut self.garment else { return };
+        if sewing.is_sewn() {
+            return;
+        }
+        let x = &self.state.x;
+        // The seams decide: an attached vertex whose anchor disagrees with its seam partner's
+        // is pinned where the two settle.
+        let gap = self.model.sewing.largest_gap(x);
+        if gap > sewing.closed_gap {
+            return;
+        }
+        let mut model = sewing.welded.take().expect("the welded model waits until the weld");
+        let n = model.vertex_count();
+        let (mut mass, mut position, mut velocity) = (vec![0.0; n], vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+        for (v, &w) in sewing.weld_map.iter().enumerate() {
+            let m = self.model.mass[v];
+            mass[w as usize] += m;
+            position[w as usize] += m * x[v];
+            velocity[w as usize] += m * self.state.v[v];
+        }
+        for w in 0..n {
+            position[w] /= mass[w];
+            velocity[w] /= mass[w];
+        }
+        for v in self.model.fixed.iter().enumerate().filter(|(_, f)| **f).map(|(v, _)| v as u32).chain(sewing.pin_after.iter().copied()) {
+            let w = sewing.weld_map[v as usize];
+            model.pin(w, position[w as usize]);
+        }
+        if let Some(contact) = &mut model.contact {
+            contact.settings.self_collision = sewing.self_collision;
+        }
+        model.options = self.model.options;
+        model.options.damping = sewing.damping.1;
+        let mut state = State::at_rest(position);
+        state.v = velocity;
+        state.time = self.state.time;
+        state.steps = self.state.steps;
+        let mut integrator = levels::level_config(&self.config, self.level_edge).solver.integrator();
+        integrator.contact_stats = self.integrator.contact_stats;
+        sewing.sewn_at = Some(self.state.time);
+        sewing.gap_at_weld = Some(gap);
+        if let super::rigs::Rig::Garment(rig) = &mut self.rig {
+            rig.welded(&sewing.weld_map, self.state.time, gap);
+        }
+        self.model = model;
+        self.state = state;
+        self.integrator = integrator;
+    }
+}
