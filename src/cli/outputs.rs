@@ -51,5 +51,5 @@ pub fn folder(flag: &str, dir: &Path) -> Result<(), String> {
     if dir.exists() && !dir.is_dir() {
         return Err(format!("{flag} {}: is a file; {flag} names a folder to write into", dir.display()));
     }
-    std::fs::create_dir_all(dir).map_err(|e| format!("{flag} {}: cannot create the folder: {e}", dir.display()))
+    std::fs::create_dir_all(dir).map_err(|e| format!("{flag} {}: cannot write there (cannot create the folder: {e})", dir.display()))
 }
