@@ -256,7 +256,7 @@ fn step_log_has_a_row_per_step() {
     let simulated = metrics["simulated_seconds"].as_f64().unwrap();
     assert!((rows.last().unwrap()[time] - simulated).abs() < 1e-9);
     let missing = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("no-such-dir").join("steps.csv");
-    assert_bad_input(&["run", "cantilever", "--duration", "0.01", "--step-log", missing.to_str().unwrap()], &["step log", "no-such-dir"]);
+    assert_bad_input(&["run", "cantilever", "--duration", "0.01", "--step-log", missing.to_str().unwrap()], &["--step-log", "no-such-dir"]);
 }
 
 #[test]

@@ -41,7 +41,7 @@ impl FileKind {
         match self {
             FileKind::Scene => "scene file",
             FileKind::Fabric => "fabric file",
-            FileKind::Obj => "OBJ mesh",
+            FileKind::Obj => "mesh file (OBJ)",
             FileKind::Csv => "CSV file",
         }
     }
@@ -266,7 +266,7 @@ mod tests {
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
         let err = read_text(&path, FileKind::Obj).unwrap_err().to_string();
         std::fs::remove_file(&path).ok();
-        assert!(err.contains("FIFO") && err.contains("OBJ"), "{err}");
+        assert!(err.contains("FIFO") && err.contains("mesh file (OBJ)"), "{err}");
     }
 
     #[test]
