@@ -17,7 +17,6 @@ use std::time::{Duration, Instant};
 /// What one run of the binary did.
 struct Outcome {
     code: Option<i32>,
-    stdout: String,
     stderr: String,
     timed_out: bool,
 }
@@ -54,8 +53,11 @@ fn rosette_with(args: &[String], stdout: Stdio, env: &[(&str, &str)], limit: Dur
         }
         std::thread::sleep(Duration::from_millis(5));
     };
-    let stdout = out_reader.map(|r| r.join().unwrap_or_default()).unwrap_or_default();
-    Outcome { code: status.code(), stdout, stderr: err_reader.join().unwrap_or_default(), timed_out }
+    // Standard output is drained so that the command never waits on a full pipe.
+    if let Some(reader) = out_reader {
+        reader.join().ok();
+    }
+    Outcome { code: status.code(), stderr: err_reader.join().unwrap_or_default(), timed_out }
 }
 
 fn rosette(args: &[String]) -> Outcome {

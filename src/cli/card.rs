@@ -3,7 +3,7 @@
 //! bar, the outputs and the exit codes).
 
 use super::outputs::{self, CARD_JSON, COMPARE_CSV, COMPARE_JSON, PICTURE};
-use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, bad_input, lost_output, with_bar};
+use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, bad_input, lost_output, say_error, with_bar};
 use rosette::errln;
 use rosette::io::guard::Plan;
 use std::path::Path;
@@ -35,7 +35,7 @@ pub fn card(spec: &str, out: &Path, force: bool) -> ExitCode {
         Err(e @ CardError::BadInput(_)) => return bad_input(e),
         Err(e @ CardError::Output(_)) => return lost_output(e),
         Err(e) => {
-            errln!("error: {stem}: {e}");
+            say_error(format!("{stem}: {e}"));
             return ExitCode::from(EXIT_DIVERGED);
         }
     };
@@ -131,7 +131,7 @@ pub fn compare(fabrics: &[String], scene: &str, overrides: &[String], out: &Path
     let json = serde_json::to_string_pretty(&comparison).expect("numbers serialise") + "\n";
     for (path, text) in [(&paths[1], json), (&paths[2], comparison.csv())] {
         if let Err(e) = rosette::io::write::whole(path, text.as_bytes()) {
-            errln!("error: cannot write {}: {e}", path.display());
+            say_error(format!("cannot write {}: {e}", path.display()));
             failed_output = true;
         }
     }
@@ -140,12 +140,12 @@ pub fn compare(fabrics: &[String], scene: &str, overrides: &[String], out: &Path
     match compare::contact_sheet(&comparison, &pictures).and_then(|(pixels, size)| rosette::card::picture::save_png(out, pixels, size)) {
         Ok(()) => errln!("wrote {}, {} and {} ({:.1} CPU s, {:.1} s wall)", out.display(), paths[1].display(), paths[2].display(), comparison.cpu_seconds, comparison.wall_seconds),
         Err(e) => {
-            errln!("error: {e}");
+            say_error(&e);
             failed_output = true;
         }
     }
     if comparison.entries.iter().any(|e| e.error.is_some()) {
-        errln!("error: some drapes failed; the sheet says which");
+        say_error("some drapes failed; the sheet says which");
         return ExitCode::from(EXIT_DIVERGED);
     }
     if let Some(e) = picture_error {

@@ -2,7 +2,7 @@
 //! the virtual laboratory's check.
 
 use super::outputs::{self, FABRIC_FILE};
-use super::{EXIT_DIVERGED, EXIT_READBACK, bad_input, lost_output};
+use super::{EXIT_DIVERGED, EXIT_READBACK, bad_input, lost_output, say_error};
 use rosette::fabric::{SheetKind, load_fabric, write};
 use rosette::io::guard::Plan;
 use rosette::{errln, out, outln};
@@ -92,7 +92,7 @@ pub fn check(fabric: &str) -> ExitCode {
             if r.all_pass() { ExitCode::SUCCESS } else { ExitCode::from(EXIT_READBACK) }
         }
         Err(e) => {
-            errln!("error: {e}");
+            say_error(&e);
             ExitCode::from(EXIT_DIVERGED)
         }
     }

@@ -24,14 +24,20 @@ pub const EXIT_STOPPED: u8 = 6;
 /// `rosette fabric check`: a virtual test read a sheet value outside its tolerance.
 pub const EXIT_READBACK: u8 = 7;
 
+/// Says an error on standard error, its numbers to a few figures (a value of 1e300 quoted
+/// as its 301 digits helps nobody).
+pub fn say_error(message: impl std::fmt::Display) {
+    errln!("error: {}", rosette::io::number::shorten_in(&message.to_string()));
+}
+
 pub fn bad_input(message: impl std::fmt::Display) -> ExitCode {
-    errln!("error: {message}");
+    say_error(message);
     ExitCode::from(EXIT_BAD_INPUT)
 }
 
 /// An output that failed after the work was done.
 pub fn lost_output(message: impl std::fmt::Display) -> ExitCode {
-    errln!("error: {message}");
+    say_error(message);
     ExitCode::from(EXIT_NO_OUTPUT)
 }
 

@@ -2,7 +2,7 @@
 //! after it, and an exit code that says how it ended.
 
 use super::outputs::{self, GLTF, METRICS, OUTLINE, PICTURE, STEP_LOG};
-use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, EXIT_NOT_CONVERGED, EXIT_STOPPED, bad_input};
+use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, EXIT_NOT_CONVERGED, EXIT_STOPPED, bad_input, say_error};
 use crate::ScreenshotArgs;
 use rosette::io::guard::Plan;
 use rosette::io::number::short;
@@ -171,7 +171,7 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
     // Every output is attempted, whatever failed before it: the run's results are kept.
     let mut output_failed = false;
     let mut fail = |e: String| {
-        errln!("error: {e}");
+        say_error(&e);
         output_failed = true;
     };
     if let Err(e) = write_metrics(&metrics, outputs.metrics) {
@@ -228,11 +228,11 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
 /// unconverged run is what the caller most needs to know), then a lost output.
 fn outcome(name: &str, scene: &Scene, metrics: &rosette::scene::Metrics, error: Option<rosette::sim::StepError>, output_failed: bool) -> ExitCode {
     if let Some(e) = error {
-        errln!("error: {e}");
+        say_error(&e);
         return ExitCode::from(EXIT_DIVERGED);
     }
     if let Some(reason) = &metrics.stopped_at_limit {
-        errln!("error: {name}: {reason}; the results cover {:.4} s", metrics.simulated_seconds);
+        say_error(format!("{name}: {reason}; the results cover {:.4} s", metrics.simulated_seconds));
         return ExitCode::from(EXIT_STOPPED);
     }
     if !metrics.converged {

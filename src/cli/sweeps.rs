@@ -2,7 +2,7 @@
 //! first run, so that a bad `--out` costs nothing.
 
 use super::outputs::{self, ACCURACY_CSV, BENCH_CSV, BENCH_JSON, DRAPE_REFERENCE_CSV, PICTURE, STABILITY_CSV};
-use super::{EXIT_DIVERGED, bad_input, lost_output};
+use super::{EXIT_DIVERGED, bad_input, lost_output, say_error};
 use rosette::io::guard::Plan;
 use rosette::{errln, outln};
 use std::path::{Path, PathBuf};
@@ -52,7 +52,7 @@ pub fn bench(out: &Path, quick: bool, threads: &[usize], force: bool) -> ExitCod
     let rows = match rosette::bench::measure(quick, threads) {
         Ok(rows) => rows,
         Err(e) => {
-            errln!("error: {e:#}");
+            say_error(format!("{e:#}"));
             return ExitCode::from(EXIT_DIVERGED);
         }
     };

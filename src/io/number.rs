@@ -28,9 +28,57 @@ pub fn short(v: f64) -> String {
     }
 }
 
+/// `text` with every number of 16 digits or more written [`short`]: the last defence of a
+/// message against the digits of a value the user (or serde, or `format!("{}")`) wrote out
+/// in full. Shorter numbers (counts, line numbers, exact values) are left as they are.
+pub fn shorten_in(text: &str) -> String {
+    let bytes = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let starts_number = bytes[i].is_ascii_digit() && (i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'.'));
+        if !starts_number {
+            let c = text[i..].chars().next().expect("inside the text");
+            out.push(c);
+            i += c.len_utf8();
+            continue;
+        }
+        // digits, an optional fraction, an optional exponent
+        let mut end = i;
+        let digits = |from: usize| from + bytes[from..].iter().take_while(|b| b.is_ascii_digit()).count();
+        end = digits(end);
+        if end < bytes.len() && bytes[end] == b'.' && end + 1 < bytes.len() && bytes[end + 1].is_ascii_digit() {
+            end = digits(end + 1);
+        }
+        if end < bytes.len() && (bytes[end] == b'e' || bytes[end] == b'E') {
+            let sign = usize::from(end + 1 < bytes.len() && (bytes[end + 1] == b'-' || bytes[end + 1] == b'+'));
+            if end + 1 + sign < bytes.len() && bytes[end + 1 + sign].is_ascii_digit() {
+                end = digits(end + 1 + sign);
+            }
+        }
+        let token = &text[i..end];
+        let count = token.bytes().filter(u8::is_ascii_digit).count();
+        match token.parse::<f64>() {
+            Ok(v) if count >= 16 => out.push_str(&short(v)),
+            _ => out.push_str(token),
+        }
+        i = end;
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
-    use super::short;
+    use super::{short, shorten_in};
+
+    #[test]
+    fn long_numbers_in_a_message_are_cut_and_the_rest_left_alone() {
+        let long = format!("{}", 1e300);
+        assert_eq!(shorten_in(&format!("got -{long}, want 3; line 12")), "got -1e300, want 3; line 12");
+        assert_eq!(shorten_in(&format!("[[{}, 5]]", 1e-300)), "[[1e-300, 5]]");
+        assert_eq!(shorten_in("v2 0.30000000000000004 µN·m"), "v2 0.3 µN·m");
+        assert_eq!(shorten_in("1234567890123 steps"), "1234567890123 steps");
+    }
 
     #[test]
     fn short_numbers_keep_what_was_written_and_long_ones_are_cut_to_four_figures() {

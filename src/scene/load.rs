@@ -113,7 +113,8 @@ fn type_error(key: &str, message: &str, example: Option<String>) -> String {
             .replace("string", "the text")
             .replace("sequence", "an array")
     };
-    let message = message.trim();
+    let message = crate::io::number::shorten_in(message.trim());
+    let message = message.as_str();
     // serde's "invalid type: X, expected Y" (and value, length) read as "must be Y, got X".
     let reworded = ["invalid type: ", "invalid value: ", "invalid length "].iter().find_map(|lead| {
         let (got, expected) = message.strip_prefix(lead)?.split_once(", expected ")?;
@@ -231,7 +232,11 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
     super::validate::check_scene_for(&config, flags.duration).map_err(|e| match (e.key.as_str(), flags.duration) {
         ("--duration", Some(d)) => PresetError::Invalid { file: format!("--duration {}", short(d)), message: sources.in_flags(e.message) },
         (key, _) if key.starts_with("fabric.") => sources.fabric_invalid(key, e.message),
-        (key, _) => sources.invalid(&key_parts(key), e.message),
+        (key, _) => {
+            // Traced to a `--set` of any key the value was weighed against, if there is one.
+            let set = std::iter::once(key).chain(e.also.iter().map(String::as_str)).map(key_parts).find(|k| sources.blame(k).starts_with("--"));
+            sources.invalid(&set.unwrap_or_else(|| key_parts(key)), e.message)
+        }
     })?;
     Ok((config, file))
 }

@@ -56,8 +56,10 @@ pub fn check_motion_fits(config: &SceneConfig) -> Result<(), Invalid> {
     }
     .unwrap_or(f64::NAN);
     let speed = config.test.speed.unwrap_or(f64::NAN);
+    let also = ["test.speed", "scene.duration", "cloth.length", "cloth.width", "test.shear_kinematics"].map(String::from).to_vec();
     Err(Invalid {
         key: key.to_string(),
+        also,
         message: format!(
             "{key} = {} at test.speed = {} m/s takes {} s, longer than scene.duration = {} s: the run would end at {:.0} % of it. \
              Set scene.duration to at least {}, or test.speed to at least {} m/s",

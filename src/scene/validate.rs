@@ -16,10 +16,14 @@ use crate::sim::mesh::{MAX_VERTICES, planned_vertices};
 pub struct Invalid {
     pub key: String,
     pub message: String,
+    /// Other keys the refused value was weighed against: where the user set one of them
+    /// (`--set test.speed=1e-300` against the scene's `test.max_strain`), the refusal is
+    /// traced to it.
+    pub also: Vec<String>,
 }
 
 fn invalid(key: &str, message: String) -> Invalid {
-    Invalid { key: key.to_string(), message }
+    Invalid { key: key.to_string(), message, also: Vec::new() }
 }
 
 fn positive(key: &str, v: f64) -> Result<f64, Invalid> {
@@ -55,8 +59,8 @@ fn point(key: &str, p: [f64; 3]) -> Result<(), Invalid> {
 pub fn check_step_count(key: &str, duration: f64, dt: f64, max_steps: u64) -> Result<(), Invalid> {
     let needed = (duration / dt).ceil();
     if needed > max_steps as f64 {
-        // A bound past 1e12 steps would run for years: not worth offering.
-        let raise = if needed < 1e12 { format!(", or raise the bound (--max-steps {needed:.0})") } else { String::new() };
+        // A bound past 1e15 steps would run for millennia: not worth offering.
+        let raise = if needed < 1e15 { format!(", or raise the bound (--max-steps {needed:.0})") } else { String::new() };
         return Err(invalid(
             key,
             format!(
@@ -241,7 +245,7 @@ struct Extent {
 fn check_cloth(c: &SceneConfig) -> Result<Extent, Invalid> {
     let cloth = &c.cloth;
     if !(cloth.warp_angle_deg.is_finite() && cloth.warp_angle_deg.abs() <= 360.0) {
-        return Err(invalid("cloth.warp_angle_deg", format!("cloth.warp_angle_deg must be an angle between -360 and 360 degrees, got {}", cloth.warp_angle_deg)));
+        return Err(invalid("cloth.warp_angle_deg", format!("cloth.warp_angle_deg must be an angle between -360 and 360 degrees, got {}", short(cloth.warp_angle_deg))));
     }
     point("cloth.position", cloth.position)?;
     let size = |key: &str, v: f64| positive_at_most(key, v, MAX_REACH, "larger than the room contact resolves");
@@ -304,7 +308,7 @@ fn check_mesh(c: &SceneConfig, extent: &Extent) -> Result<(), Invalid> {
             if planned(mid) > MAX_VERTICES { fails = mid } else { passes = mid }
         }
         let least = 1.001 * passes;
-        return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {} m gives about {vertices} vertices, more than the limit of {MAX_VERTICES}; use at least {least:.3e} m", short(h))));
+        return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {} m gives about {} vertices, more than the limit of {MAX_VERTICES}; use at least {least:.3e} m", short(h), short(vertices as f64))));
     }
     Ok(())
 }
