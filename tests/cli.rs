@@ -227,7 +227,7 @@ fn outline_csv_of_a_drape() {
     assert_eq!(rows.len(), 720);
     assert!(rows.windows(2).all(|w| w[1].0 > w[0].0) && rows[0].0 == 0.0 && rows[719].0 < 360.0);
     assert!(rows.iter().all(|&(_, r)| r > 0.09 && r <= 0.15 + 1e-3), "radii between the pedestal and the specimen");
-    let out = rosette(&["run", "tensile-warp", "--duration", "0.01", "--outline", path.to_str().unwrap()]);
+    let out = rosette(&["run", "tensile-warp", "--duration", "0.04", "--outline", path.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("not a drape scene"), "{}", text(&out.stderr));
 }

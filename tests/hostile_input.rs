@@ -236,7 +236,8 @@ fn a_picosecond_step_is_refused_by_the_step_bound_instead_of_running_for_ever() 
     assert_refused(&["run", "cusick-drape-30", "--set", "solver.dt=1e-12"], &["solver.dt", "scene.max_steps", "--max-steps"]);
     assert_refused(&["run", "cantilever", "--duration", "1e9"], &["--duration", "--max-steps"]);
     // Raised, the bound lets the same run through its check.
-    assert_refused(&["run", "cantilever", "--max-steps", "0"], &["scene.max_steps"]);
+    // Named as the user wrote it (the flag, not the scene key it sets).
+    assert_refused(&["run", "cantilever", "--max-steps", "0"], &["--max-steps 0", "at least 1"]);
 }
 
 #[test]
