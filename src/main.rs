@@ -41,7 +41,8 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         overrides: Vec<String>,
         /// Simulated seconds (default: the scene's scene.duration).
-        #[arg(long)]
+        // A negative value is taken as a value (and refused naming the flag), not as a flag.
+        #[arg(long, allow_hyphen_values = true)]
         duration: Option<f64>,
         /// Write the metrics JSON to FILE, or to standard output with '-'.
         #[arg(long, value_name = "FILE|-")]
@@ -58,7 +59,7 @@ enum Command {
         #[arg(long, value_name = "N")]
         max_steps: Option<u64>,
         /// Wall-clock seconds after which the run stops, keeping what it has (exit 6).
-        #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_MAX_WALL)]
+        #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_MAX_WALL, allow_hyphen_values = true)]
         max_wall: f64,
         /// Take the fast path (solver.path = "fast"): settling scenes settle coarse to fine,
         /// with longer steps and Newton solved to the step's own accuracy (docs/solvers.md).

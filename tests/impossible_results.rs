@@ -176,6 +176,9 @@ fn max_steps_is_checked_against_the_duration_asked_for_and_named_as_written() {
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     assert_refused(&["run", "cantilever", "--max-steps", "3"], &["--max-steps 3", "scene.duration"], &["scene.max_steps"]);
     assert_refused(&["run", "cantilever", "--duration", "1", "--max-steps", "3"], &["--duration 1", "--max-steps 3"], &["scene.max_steps"]);
+    // A negative bound is a value to refuse by its flag, not an unknown flag `-1`.
+    assert_refused(&["run", "cantilever", "--max-wall", "-1"], &["--max-wall", "-1"], &["unexpected argument"]);
+    assert_refused(&["run", "cantilever", "--duration", "-2"], &["--duration", "-2"], &["unexpected argument"]);
 }
 
 /// Messages quote values to a few figures: `--set fabric.areal_density=-1e300` printed all

@@ -14,6 +14,8 @@
 # Prints one line per case that is not clean, then the counts.
 
 set -u
+# Seconds before a case counts as hung (PROBE_TIMEOUT=10 for a quick look at an old binary).
+LIMIT=${PROBE_TIMEOUT:-60}
 BIN=$(realpath "${1:-target/release/rosette}")
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/rosette-probe.XXXXXX")
@@ -37,7 +39,7 @@ probe() {
     cases=$((cases + 1))
     local before after code out why=""
     before=$(sums)
-    out=$(timeout 60 "$@" 2>&1 >"$WORK/stdout.txt")
+    out=$(timeout "$LIMIT" "$@" 2>&1 >"$WORK/stdout.txt")
     code=$?
     after=$(sums)
     [[ " $codes " == *" $code "* ]] || why+="exit $code (wanted $codes); "
