@@ -10,7 +10,8 @@
 use crate::scene::Metrics;
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
-use std::io::Write;
+use crate::outln;
+use std::fmt::Write;
 use std::path::Path;
 use std::process::Command;
 
@@ -185,17 +186,28 @@ fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
 
 /// Runs the benchmark and writes `bench.csv` and `bench.json` into `out`.
 pub fn run(out: &Path, quick: bool, threads: &[usize]) -> Result<Vec<BenchRow>> {
-    let exe = std::env::current_exe().context("locating the rosette executable")?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let rows = measure(quick, threads)?;
+    write(out, &rows)?;
+    Ok(rows)
+}
+
+/// Runs every case with every thread count (each in a child `rosette run`) and prints
+/// the table and its summary.
+pub fn measure(quick: bool, threads: &[usize]) -> Result<Vec<BenchRow>> {
+    if let Some(t) = threads.iter().find(|&&t| t == 0) {
+        bail!("--threads {t}: a run needs at least one thread");
+    }
+    let exe = std::env::current_exe().context("locating the rosette executable")?;
     let mut rows = Vec::new();
-    println!(
+    outln!(
         "{:<46} {:>3} {:>7} {:>10} {:>10} {:>6} {:>6} {:>6} {:>7} {:>7} {:>8}",
         "case", "thr", "tris", "CPU s/s", "wall s/s", "forces", "solve", "contact", "newton", "cg/nwt", "peak MB"
     );
     for case in cases(quick) {
         for &t in threads.iter().filter(|t| case.threads.is_none_or(|only| only.contains(t))) {
             let row = run_case(&exe, &case, t)?;
-            println!(
+            outln!(
                 "{:<46} {:>3} {:>7} {:>10.4} {:>10.4} {:>5.0}% {:>5.0}% {:>6.0}% {:>7.2} {:>7.1} {:>8.1}",
                 row.case,
                 row.threads,
@@ -213,10 +225,17 @@ pub fn run(out: &Path, quick: bool, threads: &[usize]) -> Result<Vec<BenchRow>> 
         }
     }
     summarise(&rows);
-    write_csv(&out.join("bench.csv"), &rows)?;
-    std::fs::write(out.join("bench.json"), serde_json::to_string_pretty(&rows)?)?;
-    println!("wrote {} and {}", out.join("bench.csv").display(), out.join("bench.json").display());
     Ok(rows)
+}
+
+/// Writes `bench.csv` and `bench.json` into `out`, each whole or not at all.
+pub fn write(out: &Path, rows: &[BenchRow]) -> Result<()> {
+    let (csv, json) = (out.join("bench.csv"), out.join("bench.json"));
+    crate::io::write::whole(&csv, csv_text(rows).as_bytes()).with_context(|| format!("cannot write {}", csv.display()))?;
+    let text = serde_json::to_string_pretty(rows)? + "\n";
+    crate::io::write::whole(&json, text.as_bytes()).with_context(|| format!("cannot write {}", json.display()))?;
+    outln!("wrote {} and {}", csv.display(), json.display());
+    Ok(())
 }
 
 /// Prints the ratios the rows imply: against the paper, thread speed-up, memory per vertex.
@@ -224,10 +243,10 @@ fn summarise(rows: &[BenchRow]) {
     for r in rows.iter().filter(|r| r.threads == 1) {
         if let Some(paper) = r.paper_cpu_seconds_per_10ms {
             let ours = r.cpu_seconds_per_simulated_second * 0.01;
-            println!("{}: {ours:.5} CPU s per 10 ms, {:.0}x faster than the paper's {paper}", r.case, paper / ours);
+            outln!("{}: {ours:.5} CPU s per 10 ms, {:.0}x faster than the paper's {paper}", r.case, paper / ours);
         }
         if let Some(two) = rows.iter().find(|o| o.case == r.case && o.threads == 2) {
-            println!("{}: 1 -> 2 threads, wall-clock speed-up {:.2}x", r.case, r.wall_seconds / two.wall_seconds);
+            outln!("{}: 1 -> 2 threads, wall-clock speed-up {:.2}x", r.case, r.wall_seconds / two.wall_seconds);
         }
     }
     for solver in SOLVERS {
@@ -236,11 +255,11 @@ fn summarise(rows: &[BenchRow]) {
             && large.vertices > small.vertices
         {
             let per_vertex = (large.peak_memory_mb - small.peak_memory_mb) * 1e6 / (large.vertices - small.vertices) as f64;
-            println!("{solver}: memory {per_vertex:.0} bytes per vertex (peak resident growth from {} to {} vertices)", small.vertices, large.vertices);
+            outln!("{solver}: memory {per_vertex:.0} bytes per vertex (peak resident growth from {} to {} vertices)", small.vertices, large.vertices);
             // Cost ∝ N^p between the smallest and the largest drape: p = 1 is linear growth.
             let exponent = (large.cpu_seconds_per_simulated_second / small.cpu_seconds_per_simulated_second).ln()
                 / (large.triangles as f64 / small.triangles as f64).ln();
-            println!(
+            outln!(
                 "{solver}: cost growth, CPU per simulated second grows as (triangles)^{exponent:.2} from {} to {} triangles",
                 small.triangles, large.triangles
             );
@@ -252,7 +271,7 @@ fn summarise(rows: &[BenchRow]) {
     // iterations and counts step time only, not the set-up outside the steps.
     for r in rows.iter().filter(|r| r.case.ends_with(SOLVERS[0])) {
         if let Some(bound) = r.solver_speedup_bound {
-            println!(
+            outln!(
                 "{} tri, {} thread(s): the linear solve is {:.0} % of the complete factor's step time; no solver can make this run more than {bound:.2}x faster",
                 r.triangles,
                 r.threads,
@@ -266,7 +285,7 @@ fn summarise(rows: &[BenchRow]) {
         let exact_case = fast.case.replace(", fast", ", exact");
         let Some(exact) = rows.iter().find(|o| o.case == exact_case && o.threads == fast.threads) else { continue };
         let drape = |r: &BenchRow| r.drape_coefficient.map_or(String::new(), |dc| format!(", DC {dc:.3} with {} nodes", r.nodes.unwrap_or(0)));
-        println!(
+        outln!(
             "{}, {} thread(s): fast path {:.1} s wall ({:.2}x real time{}) against exact {:.1} s ({}): {:.1}x faster",
             fast.case.trim_end_matches(", fast"),
             fast.threads,
@@ -287,28 +306,28 @@ fn summarise(rows: &[BenchRow]) {
         let (a, b) = (pair[0], pair[1]);
         if a.threads == b.threads && b.triangles > a.triangles {
             let exponent = (b.wall_seconds_per_simulated_second / a.wall_seconds_per_simulated_second).ln() / (b.triangles as f64 / a.triangles as f64).ln();
-            println!("fast path: wall s per simulated s grows as (triangles)^{exponent:.2} from {} to {} triangles", a.triangles, b.triangles);
+            outln!("fast path: wall s per simulated s grows as (triangles)^{exponent:.2} from {} to {} triangles", a.triangles, b.triangles);
         }
     }
     // Multigrid against the complete factor at each size and thread count (wall time).
     for r in rows.iter().filter(|r| r.case.ends_with(SOLVERS[1])) {
         let direct_case = r.case.replace(SOLVERS[1], SOLVERS[0]);
         if let Some(direct) = rows.iter().find(|o| o.case == direct_case && o.threads == r.threads) {
-            println!("{} tri, {} thread(s): multigrid {:.2}x the speed of the complete factor", r.triangles, r.threads, direct.wall_seconds / r.wall_seconds);
+            outln!("{} tri, {} thread(s): multigrid {:.2}x the speed of the complete factor", r.triangles, r.threads, direct.wall_seconds / r.wall_seconds);
         }
     }
 }
 
-fn write_csv(path: &Path, rows: &[BenchRow]) -> Result<()> {
-    let mut f = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    writeln!(
+fn csv_text(rows: &[BenchRow]) -> String {
+    let mut f = String::new();
+    let _ = writeln!(
         f,
         "case,threads,triangles,vertices,steps,simulated_seconds,wall_seconds,cpu_seconds_per_simulated_second,\
          wall_seconds_per_simulated_second,forces_share,solve_share,contact_share,solver_speedup_bound,newton_per_step,cg_per_newton,\
          peak_memory_mb,paper_cpu_seconds_per_10ms,path,drape_coefficient,nodes,settled,max_penetration,self_intersections"
-    )?;
+    );
     for r in rows {
-        writeln!(
+        let _ = writeln!(
             f,
             "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.case,
@@ -334,7 +353,7 @@ fn write_csv(path: &Path, rows: &[BenchRow]) -> Result<()> {
             r.settled.map_or(String::new(), |v| v.to_string()),
             r.max_penetration.map_or(String::new(), |v| v.to_string()),
             r.self_intersections.map_or(String::new(), |v| v.to_string())
-        )?;
+        );
     }
-    Ok(())
+    f
 }

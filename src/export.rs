@@ -234,7 +234,7 @@ pub fn glb(cloth: &Cloth, frames: &[ClothFrame]) -> Result<Vec<u8>, ExportError>
 /// Writes [`glb`] to `path`.
 pub fn write_glb(path: &Path, cloth: &Cloth, frames: &[ClothFrame]) -> Result<(), ExportError> {
     let bytes = glb(cloth, frames)?;
-    std::fs::write(path, bytes).map_err(|e| ExportError::Write { path: path.display().to_string(), message: e.to_string() })
+    crate::io::write::whole(path, &bytes).map_err(|e| ExportError::Write { path: path.display().to_string(), message: e.to_string() })
 }
 
 fn srgb_to_linear(c: f32) -> f32 {

@@ -7,7 +7,8 @@
 //! tests on them virtually; `reference` holds the analytic
 //! solutions (elastica, off-axis formulas) the tests and the chart compare against; `chart`
 //! sweeps integrators, time steps and meshes for speed against accuracy; `bench` times
-//! scenes.
+//! scenes; `io` reads the files a user names and writes every output whole, never over
+//! an input.
 pub mod app;
 pub mod bench;
 pub mod card;
@@ -15,6 +16,7 @@ pub mod chart;
 pub mod export;
 pub mod fabric;
 pub mod garment;
+pub mod io;
 pub mod lab;
 pub mod reference;
 pub mod render;

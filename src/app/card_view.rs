@@ -192,7 +192,7 @@ impl CardView {
         ui.strong(&c.fabric.name);
         egui::Grid::new("card_numbers").num_columns(4).striped(true).show(ui, |ui| {
             ui.label("drape coefficient");
-            ui.monospace(format!("{:.3}", c.drape.result.drape_coefficient));
+            ui.monospace(crate::card::dc_text(c.drape.result.drape_coefficient));
             ui.label("nodes");
             ui.monospace(c.drape.result.nodes.to_string());
             ui.end_row();

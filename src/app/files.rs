@@ -23,7 +23,7 @@ pub fn fabric_toml(fabric: &FabricConfig) -> Result<String, String> {
 /// Reads a fabric file (the format of `presets/fabrics/*.toml`, measurement sheets
 /// included) and checks its values.
 pub fn read_fabric(path: &Path) -> Result<FabricConfig, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let text = crate::io::read::read_text(path, crate::io::read::FileKind::Fabric).map_err(|e| e.to_string())?;
     let fabric = crate::fabric::parse_fabric(&text, &path.display().to_string()).map_err(|e| e.to_string())?.config;
     if fabric.preset.is_some() {
         return Err(format!(

@@ -479,7 +479,7 @@ impl ViewerUi {
             row("vertices / triangles", format!("{} / {}", s.vertices, s.triangles));
             row("integrator, dt", format!("{}, {} s", snapshot.config.solver.integrator, snapshot.config.solver.dt));
             row("steps per second", format!("{:.1}", s.steps_per_second));
-            row("CPU per 10 ms simulated", format!("{:.3} ms", s.cpu_ms_per_10ms));
+            row("step time per 10 ms simulated", format!("{:.3} ms", s.step_ms_per_10ms));
             row("real-time factor", format!("{:.2}", s.real_time_factor));
             row("step, Δt", format!("{}, {} s", s.minimizer, s.step_dt));
             if s.quasi_newton_iterations > 0 {

@@ -304,7 +304,7 @@ impl App {
             // What a scripted run of the viewer measured: the simulation's pace under the
             // window's own rendering (the toolbar's figures, once, for logs and CI).
             let s = &snapshot.stats;
-            println!(
+            crate::outln!(
                 "viewer: {} frames; {} simulated {:.3} s in {} steps on {} triangles; last second: {:.2}x real time, {:.1} steps/s",
                 self.frames, snapshot.scene_name, snapshot.time, snapshot.steps, s.triangles, s.real_time_factor, s.steps_per_second
             );
@@ -406,7 +406,7 @@ impl App {
 
     fn file_action(&mut self, kind: DialogKind, path: &Path) -> Result<(), String> {
         let snapshot = self.worker.latest();
-        let write = |text: String| std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()));
+        let write = |text: String| crate::io::write::whole(path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()));
         match kind {
             DialogKind::OpenScene => {
                 let spec = path.to_string_lossy().into_owned();
@@ -600,5 +600,5 @@ fn save_screenshot(
     let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
     encode_frame(gpu, &view, jobs, screen, snapshot, ui);
     let image = render::read_back(&gpu.device, &gpu.queue, &texture)?;
-    image.save(path).with_context(|| format!("cannot write {}", path.display()))
+    crate::io::write::png_file(path, image.as_raw(), image.dimensions(), 4, crate::io::write::Effort::Balanced).map_err(anyhow::Error::msg)
 }

@@ -65,7 +65,7 @@ impl Comparison {
                 "{},{},{},{},{},{},{},{},{},{}\n",
                 quote(&e.fabric),
                 quote(&e.name),
-                e.result.drape_coefficient,
+                if e.result.drape_coefficient.is_finite() { e.result.drape_coefficient.to_string() } else { String::new() },
                 e.result.nodes,
                 e.result.outline_radius_min_mm,
                 e.result.outline_radius_max_mm,
@@ -187,7 +187,7 @@ pub fn contact_sheet(comparison: &Comparison, pictures: &[RgbaImage]) -> Result<
             root.draw_text(&picture::wrap(&label, 46)[0], &name, (x, y)).map_err(|e| e.to_string())?;
             let (line, style) = match &e.error {
                 Some(error) => (picture::wrap(&format!("failed: {error}"), 52)[0].clone(), &bad),
-                None => (format!("DC {:.3}   {} nodes   {}", e.result.drape_coefficient, e.result.nodes, e.result.settle_status()), &small),
+                None => (format!("DC {}   {} nodes   {}", super::dc_text(e.result.drape_coefficient), e.result.nodes, e.result.settle_status()), &small),
             };
             root.draw_text(&line, style, (x, y + 24)).map_err(|e| e.to_string())?;
         }

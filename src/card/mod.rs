@@ -65,8 +65,8 @@ impl Made {
     pub fn write(&self, dir: &std::path::Path, stem: &str) -> Result<[std::path::PathBuf; 2], CardError> {
         let json = dir.join(format!("{stem}.json"));
         let png = dir.join(format!("{stem}.png"));
-        let text = serde_json::to_string_pretty(&self.card).map_err(|e| CardError::Output(e.to_string()))?;
-        std::fs::write(&json, text + "\n").map_err(|e| CardError::Output(format!("cannot write {}: {e}", json.display())))?;
+        let text = serde_json::to_string_pretty(&self.card).map_err(|e| CardError::Output(e.to_string()))? + "\n";
+        crate::io::write::whole(&json, text.as_bytes()).map_err(|e| CardError::Output(format!("cannot write {}: {e}", json.display())))?;
         picture::save_png(&png, self.page.clone(), page::SIZE).map_err(CardError::Output)?;
         Ok([json, png])
     }
@@ -212,10 +212,26 @@ pub struct Drape {
     pub outline: Curve,
 }
 
+/// A drape coefficient for people: three decimals, or "not measured" where the run gave
+/// none (a cloth that had not draped, `scene::possible::judge`).
+pub fn dc_text(drape_coefficient: f64) -> String {
+    if drape_coefficient.is_finite() { format!("{drape_coefficient:.3}") } else { "not measured".into() }
+}
+
+fn not_measured() -> f64 {
+    f64::NAN
+}
+
+fn is_not_measured(value: &f64) -> bool {
+    value.is_nan()
+}
+
 /// What a drape run came to, as the card and `rosette compare` both report it.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct DrapeResult {
-    /// (A_shadow − A_support)/(A_specimen − A_support).
+    /// (A_shadow − A_support)/(A_specimen − A_support); NaN, and absent from the JSON,
+    /// where the run measured none.
+    #[serde(default = "not_measured", skip_serializing_if = "is_not_measured")]
     pub drape_coefficient: f64,
     pub nodes: usize,
     pub outline_radius_min_mm: f64,

@@ -64,7 +64,7 @@ pub fn draw(card: &Card, pictures: Result<&[RgbaImage; 2], &str>) -> Result<Vec<
         curve_panel(&shear_area, "Shear (KES-FB1, 20 cm × 5 cm)", &line, &s.curve, &input, "G·γ").map_err(|e| e.to_string())?;
         let d = &card.drape;
         let captions = [
-            format!("From above: DC {:.3}, {} nodes", d.result.drape_coefficient, d.result.nodes),
+            format!("From above: DC {}, {} nodes", super::dc_text(d.result.drape_coefficient), d.result.nodes),
             format!("From the side: {:.0} mm disc on a {:.0} mm support", d.specimen_diameter_mm, d.support_diameter_mm),
         ];
         for (area, caption) in [above_area, side_area].iter().zip(captions) {
@@ -202,7 +202,7 @@ fn tables(area: &Area, card: &Card) -> DrawResult {
     let mut t = Table { area: &columns[2], y: 8 };
     t.heading(&format!("Cusick drape ({})", d.scene))?;
     let lines = [
-        format!("drape coefficient DC  {:.3}", d.result.drape_coefficient),
+        format!("drape coefficient DC  {}", super::dc_text(d.result.drape_coefficient)),
         format!("nodes  {}", d.result.nodes),
         format!("shadow radius  {:.1} to {:.1} mm", d.result.outline_radius_min_mm, d.result.outline_radius_max_mm),
         d.result.settle_status(),

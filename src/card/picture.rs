@@ -108,14 +108,10 @@ pub fn wrap(text: &str, width: usize) -> Vec<String> {
     lines
 }
 
-/// Writes an RGB buffer as a PNG, compressed as far as the encoder goes (the cards are
-/// committed under docs/).
+/// Writes an RGB buffer as a PNG, whole or not at all, compressed as far as the encoder
+/// goes (the cards are committed under docs/).
 pub fn save_png(path: &Path, buffer: Vec<u8>, size: (u32, u32)) -> Result<(), String> {
-    use image::ImageEncoder;
-    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-    let file = std::fs::File::create(path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    let encoder = PngEncoder::new_with_quality(std::io::BufWriter::new(file), CompressionType::Best, FilterType::Adaptive);
-    encoder.write_image(&buffer, size.0, size.1, image::ExtendedColorType::Rgb8).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    crate::io::write::png_file(path, &buffer, size, 3, crate::io::write::Effort::Smallest)
 }
 
 #[cfg(test)]

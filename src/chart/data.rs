@@ -134,7 +134,7 @@ fn number(value: Option<f64>) -> String {
 }
 
 fn write(path: &Path, text: &str) -> Result<(), ChartError> {
-    std::fs::write(path, text).map_err(|source| ChartError::Write { path: path.to_path_buf(), source })
+    crate::io::write::whole(path, text.as_bytes()).map_err(|source| ChartError::Write { path: path.to_path_buf(), source })
 }
 
 pub fn write_accuracy(path: &Path, rows: &[AccuracyRow]) -> Result<(), ChartError> {
@@ -186,7 +186,7 @@ pub fn write_stability(path: &Path, rows: &[StabilityRow]) -> Result<(), ChartEr
 
 /// The text of a file, or the error that names it.
 fn read_text(path: &Path) -> Result<String, ChartError> {
-    std::fs::read_to_string(path).map_err(|e| ChartError::Read { path: path.to_path_buf(), message: e.to_string() })
+    crate::io::read::read_text(path, crate::io::read::FileKind::Csv).map_err(|e| ChartError::Read { path: path.to_path_buf(), message: e.to_string() })
 }
 
 /// The records of a CSV file with the expected header, as fields.
@@ -287,7 +287,7 @@ pub fn parse_stability(text: &str, origin: &Path) -> Result<Vec<StabilityRow>, C
         .collect()
 }
 
-const DRAPE_REFERENCE_HEADER: &str = "edge_length,dt,triangles,cpu_seconds,drape_coefficient,model_revision";
+pub const DRAPE_REFERENCE_HEADER: &str = "edge_length,dt,triangles,cpu_seconds,drape_coefficient,model_revision";
 
 /// The cached drape reference, if the file holds one made with `case`'s mesh and step.
 pub fn read_drape_reference(path: &Path, case: &Case) -> Option<f64> {

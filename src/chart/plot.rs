@@ -68,8 +68,7 @@ fn log_label(v: &f64) -> String {
 }
 
 fn save(path: &Path, buffer: Vec<u8>, size: (u32, u32)) -> Result<(), String> {
-    let image = image::RgbImage::from_raw(size.0, size.1, buffer).ok_or("buffer size")?;
-    image.save(path).map_err(|e| e.to_string())
+    crate::io::write::png_file(path, &buffer, size, 3, crate::io::write::Effort::Smallest)
 }
 
 fn grid(cells: usize) -> (usize, usize) {

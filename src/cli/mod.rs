@@ -1,13 +1,86 @@
-//! `rosette card` and `rosette compare`: the fabric card and the contact sheet from the
-//! command line (the work is `rosette::card`'s; here are the checks before it, the progress
-//! bar and the exit codes).
+//! The subcommands' work between the parsed command line and the library: the checks
+//! before any work (inputs, outputs, what the run can honour), the progress bars, the
+//! outputs and the exit codes.
 
-use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, bad_input, check_writable};
+pub mod card;
+pub mod fabric;
+pub mod outputs;
+pub mod run;
+pub mod sweeps;
+
+use rosette::errln;
 use std::io::IsTerminal;
 use std::process::ExitCode;
 
+/// Exit codes (also in `--help` and the README): 0 done, 2 bad input (refused before the
+/// run), 3 the simulation diverged, 4 an output could not be rendered or written after the
+/// run, 5 the run ended but some Newton solves did not converge, 6 the run stopped at its
+/// step or wall-time bound, 7 a fabric's virtual tests disagree with its sheet, 8 a
+/// garment's seams were not closed by its sewing time.
+pub const EXIT_BAD_INPUT: u8 = 2;
+pub const EXIT_DIVERGED: u8 = 3;
+pub const EXIT_NO_OUTPUT: u8 = 4;
+pub const EXIT_NOT_CONVERGED: u8 = 5;
+pub const EXIT_STOPPED: u8 = 6;
+/// `rosette fabric check`: a virtual test read a sheet value outside its tolerance.
+pub const EXIT_READBACK: u8 = 7;
+/// A garment whose seams were still open at `garment.sewing_time`: not finished.
+pub const EXIT_NOT_SEWN: u8 = 8;
+
+/// Says an error on standard error, its numbers to a few figures (a value of 1e300 quoted
+/// as its 301 digits helps nobody).
+pub fn say_error(message: impl std::fmt::Display) {
+    errln!("error: {}", rosette::io::number::shorten_in(&message.to_string()));
+}
+
+pub fn bad_input(message: impl std::fmt::Display) -> ExitCode {
+    say_error(message);
+    ExitCode::from(EXIT_BAD_INPUT)
+}
+
+/// An output that failed after the work was done.
+pub fn lost_output(message: impl std::fmt::Display) -> ExitCode {
+    say_error(message);
+    ExitCode::from(EXIT_NO_OUTPUT)
+}
+
+/// Most threads `rosette bench --threads` takes: far more than any machine it runs on has
+/// cores, few enough that a typo (10000) is caught.
+pub const MAX_THREADS: usize = 1024;
+
+/// `--threads N`: a run needs at least one thread.
+pub fn parse_threads(text: &str) -> Result<usize, String> {
+    let n: usize = text.trim().parse().map_err(|_| format!("'{text}' is not a whole number of threads"))?;
+    if !(1..=MAX_THREADS).contains(&n) {
+        return Err(format!("{n} threads: a run takes 1 to {MAX_THREADS}"));
+    }
+    Ok(n)
+}
+
+/// Nearest and farthest camera (`--camera YAW,PITCH,DISTANCE`), m: nearer, the camera's
+/// near plane (a hundredth of the distance) falls below the renderer's single-precision
+/// depth; farther, the scene is past the kilometre its geometry resolves
+/// (`rosette::sim::contact::MAX_REACH`). `run` further checks that the cloth spans some
+/// pixels at the distance given.
+pub const CAMERA_DISTANCE: (f64, f64) = (1e-3, rosette::sim::contact::MAX_REACH);
+
+/// `--camera YAW,PITCH[,DISTANCE]`, the distance within [`CAMERA_DISTANCE`].
+pub fn parse_camera(text: &str) -> Result<(f64, f64, Option<f64>), String> {
+    let view = rosette::render::Screenshot::parse_view(text)?;
+    if let (_, _, Some(distance)) = view {
+        let (near, far) = CAMERA_DISTANCE;
+        if !(near..=far).contains(&distance) {
+            return Err(format!(
+                "--camera {text}: a distance of {} m is outside {near} to {far} m; leave it out to frame the scene",
+                rosette::io::number::short(distance)
+            ));
+        }
+    }
+    Ok(view)
+}
+
 /// Shows `progress` on a bar on stderr while `work` runs, where someone watches.
-fn with_bar<T>(label: &str, progress: &rosette::card::Progress, work: impl FnOnce() -> T) -> T {
+pub fn with_bar<T>(label: &str, progress: &rosette::card::Progress, work: impl FnOnce() -> T) -> T {
     if !std::io::stderr().is_terminal() {
         return work();
     }
@@ -31,120 +104,4 @@ fn with_bar<T>(label: &str, progress: &rosette::card::Progress, work: impl FnOnc
         done.store(true, std::sync::atomic::Ordering::Relaxed);
         result
     })
-}
-
-pub fn card(spec: &str, out: &std::path::Path) -> ExitCode {
-    use rosette::card::CardError;
-    let loaded = match rosette::fabric::load_fabric(spec) {
-        Ok(f) => f,
-        Err(e) => return bad_input(e),
-    };
-    for w in &loaded.warnings {
-        eprintln!("warning: {w}");
-    }
-    let stem = std::path::Path::new(spec).file_stem().map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into_owned());
-    if let Err(e) = std::fs::create_dir_all(out) {
-        return bad_input(format!("--out {}: cannot create the directory: {e}", out.display()));
-    }
-    for ext in ["json", "png"] {
-        if let Err(e) = check_writable("--out", &out.join(format!("{stem}.{ext}"))) {
-            return bad_input(format!("{e:#}"));
-        }
-    }
-    let progress = rosette::card::Progress::default();
-    let made = with_bar(&stem, &progress, || rosette::card::make(&loaded.config, &loaded.file, Some((&loaded.sheets, &loaded.import)), &progress));
-    let made = match made {
-        Ok(m) => m,
-        Err(e @ CardError::BadInput(_)) => return bad_input(e),
-        Err(e @ CardError::Output(_)) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(EXIT_NO_OUTPUT);
-        }
-        Err(e) => {
-            eprintln!("error: {stem}: {e}");
-            return ExitCode::from(EXIT_DIVERGED);
-        }
-    };
-    let written = made.write(out, &stem);
-    let c = &made.card;
-    eprintln!(
-        "{stem}: DC {:.3}, {} nodes; bending length warp {:.1} mm, weft {:.1} mm; {:.1} CPU s, {:.1} s wall",
-        c.drape.result.drape_coefficient, c.drape.result.nodes, c.cantilever[0].bending_length_mm, c.cantilever[1].bending_length_mm, c.cost.cpu_seconds, c.cost.wall_seconds
-    );
-    match written {
-        Ok(paths) => paths.iter().for_each(|p| eprintln!("wrote {}", p.display())),
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(EXIT_NO_OUTPUT);
-        }
-    }
-    if let Some(e) = &made.picture_error {
-        eprintln!("error: the drape pictures could not be rendered (the page has a note in their place): {e}");
-        return ExitCode::from(EXIT_NO_OUTPUT);
-    }
-    ExitCode::SUCCESS
-}
-
-pub fn compare(fabrics: &[String], scene: &str, overrides: &[String], out: &std::path::Path) -> ExitCode {
-    use rosette::card::compare;
-    if !out.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
-        return bad_input(format!("--out {}: the contact sheet is written as PNG; name the file FILE.png", out.display()));
-    }
-    let configs = match compare::configs(fabrics, scene, overrides) {
-        Ok(c) => c,
-        Err(e) => return bad_input(e),
-    };
-    let paths = [out.to_path_buf(), out.with_extension("json"), out.with_extension("csv")];
-    for path in &paths {
-        if let Err(e) = check_writable("--out", path) {
-            return bad_input(format!("{e:#}"));
-        }
-    }
-    let (wall, cpu) = (std::time::Instant::now(), cpu_time::ProcessTime::now());
-    let progress = rosette::card::Progress::default();
-    let results = with_bar("compare", &progress, || compare::run(fabrics, configs, &progress));
-    let scenes: Vec<Option<&rosette::scene::Scene>> = results.iter().map(|(_, s)| s.as_ref()).collect();
-    let pictures = compare::pictures(&scenes);
-    let (yaw, pitch) = compare::camera_angles();
-    let comparison = compare::Comparison {
-        scene: scene.to_string(),
-        overrides: overrides.to_vec(),
-        camera_yaw_deg: yaw,
-        camera_pitch_deg: pitch,
-        entries: results.iter().map(|(e, _)| e.clone()).collect(),
-        cpu_seconds: cpu.elapsed().as_secs_f64(),
-        wall_seconds: wall.elapsed().as_secs_f64(),
-    };
-    for e in &comparison.entries {
-        match &e.error {
-            None => eprintln!("{:<20} DC {:.3}  {} nodes", e.fabric, e.result.drape_coefficient, e.result.nodes),
-            Some(error) => eprintln!("{:<20} failed: {error}", e.fabric),
-        }
-    }
-    let mut failed_output = false;
-    let json = serde_json::to_string_pretty(&comparison).expect("numbers serialise") + "\n";
-    for (path, text) in [(&paths[1], json), (&paths[2], comparison.csv())] {
-        if let Err(e) = std::fs::write(path, text) {
-            eprintln!("error: cannot write {}: {e}", path.display());
-            failed_output = true;
-        }
-    }
-    let picture_error = pictures.as_ref().err().cloned();
-    let pictures = pictures.unwrap_or_else(|e| comparison.entries.iter().map(|_| rosette::card::picture::placeholder(compare::TILE, &format!("not rendered: {e}"))).collect());
-    match compare::contact_sheet(&comparison, &pictures).and_then(|(pixels, size)| rosette::card::picture::save_png(out, pixels, size)) {
-        Ok(()) => eprintln!("wrote {}, {} and {} ({:.1} CPU s, {:.1} s wall)", out.display(), paths[1].display(), paths[2].display(), comparison.cpu_seconds, comparison.wall_seconds),
-        Err(e) => {
-            eprintln!("error: {e}");
-            failed_output = true;
-        }
-    }
-    if comparison.entries.iter().any(|e| e.error.is_some()) {
-        eprintln!("error: some drapes failed; the sheet says which");
-        return ExitCode::from(EXIT_DIVERGED);
-    }
-    if let Some(e) = picture_error {
-        eprintln!("error: the drapes could not be rendered (the sheet has notes in their place): {e}");
-        return ExitCode::from(EXIT_NO_OUTPUT);
-    }
-    if failed_output { ExitCode::from(EXIT_NO_OUTPUT) } else { ExitCode::SUCCESS }
 }

@@ -228,11 +228,17 @@ pub fn plate_rigidity_for_bending_length(strip: &BiasStrip, c: f64) -> Result<f6
     // More rigidity, less droop. Eq. 3's middle term must stay positive (material.rs),
     // so B₄₅ > (B_x + B_y)/4.
     let softest = 0.25 * (strip.bending_warp + strip.bending_weft) * (1.0 + 1e-6);
+    let ceiling = 100.0 * strip.bending_warp.max(strip.bending_weft);
+    // The bending lengths the rigidity's range gives, compared first: far outside it (a
+    // 1 m bending length), the droop of a strip 2c long is no guide (its elastica folds
+    // back on itself).
+    if c > strip_bending_length(strip, ceiling) {
+        return Err(BiasError::TooLong { measured_mm: c * 1e3 });
+    }
     let droop = |b45: f64| chord_angle(&StripLaw::new(strip, b45), w, length);
     if droop(softest) < target {
         return Err(BiasError::TooShort { measured_mm: c * 1e3, shortest_mm: strip_bending_length(strip, softest) * 1e3 });
     }
-    let ceiling = 100.0 * strip.bending_warp.max(strip.bending_weft);
     let mut high = (w * c.powi(3)).max(softest * 1.01);
     while droop(high) > target {
         high *= 2.0;

@@ -9,6 +9,7 @@
 //! ([`write`]); docs/fabric-sheets.md is the user's guide to all of it.
 
 pub mod bias;
+pub mod explain;
 pub mod import;
 pub mod sheet;
 pub mod tensile;
@@ -36,11 +37,11 @@ pub struct LoadedFabric {
 
 #[derive(Debug, Error)]
 pub enum LoadError {
-    #[error("cannot read {path}: {source}")]
-    Io { path: String, source: std::io::Error },
+    #[error("{source}")]
+    Read { source: crate::io::read::ReadError },
     #[error("no bundled fabric named '{name}' and no such file; bundled fabrics: {available}")]
     Unknown { name: String, available: String },
-    #[error("{file}: not valid TOML: {message}")]
+    #[error("{file}: {message}")]
     Syntax { file: String, message: String },
     #[error("{file}: {source}")]
     Sheet { file: String, source: Box<SheetError> },
@@ -51,14 +52,19 @@ pub enum LoadError {
 /// Reads a fabric file's text: sheets converted, keys checked.
 pub fn parse_fabric(text: &str, file: &str) -> Result<LoadedFabric, LoadError> {
     let sheet_error = |source| LoadError::Sheet { file: file.into(), source: Box::new(source) };
-    let mut table: toml::Table =
-        text.parse().map_err(|e: toml::de::Error| LoadError::Syntax { file: file.into(), message: e.message().trim().into() })?;
+    // A file's contents are quoted only where it is named as a fabric file (FILE.toml).
+    let mut table = crate::io::read::parse_toml(text, Some(std::path::Path::new(file)), crate::io::read::FileKind::Fabric)
+        .map_err(|message| LoadError::Syntax { file: file.into(), message })?;
+    crate::scene::preset::refuse_fabric_preset(&table).map_err(|message| LoadError::Invalid { file: file.into(), message })?;
     let sheets = Sheets::take(&mut table).map_err(sheet_error)?;
     let import = if sheets.is_empty() { Import::default() } else { derive(&sheets, &table).map_err(sheet_error)? };
     let warnings = import::apply(&mut table, &import);
     let config: FabricConfig =
         table.try_into().map_err(|e: toml::de::Error| LoadError::Invalid { file: file.into(), message: e.message().trim().into() })?;
-    config.to_fabric().map_err(|e| LoadError::Invalid { file: file.into(), message: e.to_string() })?;
+    config.to_fabric().map_err(|e| {
+        let message = explain::explain(&import, e.key(), &e.to_string()).map_or_else(|| e.to_string(), |(text, _)| text);
+        LoadError::Invalid { file: file.into(), message }
+    })?;
     Ok(LoadedFabric { file: file.into(), config, sheets, import, warnings })
 }
 
@@ -73,6 +79,6 @@ pub fn load_fabric(spec: &str) -> Result<LoadedFabric, LoadError> {
         let available = FABRICS.iter().map(|b| b.name).collect::<Vec<_>>().join(", ");
         return Err(LoadError::Unknown { name: spec.into(), available });
     }
-    let text = std::fs::read_to_string(path).map_err(|source| LoadError::Io { path: spec.into(), source })?;
+    let text = crate::io::read::read_text(path, crate::io::read::FileKind::Fabric).map_err(|source| LoadError::Read { source })?;
     parse_fabric(&text, spec)
 }

@@ -201,10 +201,19 @@ pub enum SheetError {
     )]
     UnknownField { section: &'static str, title: &'static str, field: String, known: String },
     #[error(
-        "{section}.{field} = {written}: unknown unit '{unit}'; write a bare number in {default_unit} \
+        "{section}.{field} = {written}: unknown unit '{unit}'{hint}; write a bare number in {default_unit} \
          or a string with one of: {accepted}"
     )]
-    UnknownUnit { section: &'static str, field: String, written: String, unit: String, default_unit: &'static str, accepted: &'static str },
+    UnknownUnit {
+        section: &'static str,
+        field: String,
+        written: String,
+        unit: String,
+        /// Where the unit is one of the field's own in another case: that it is refused, and why.
+        hint: String,
+        default_unit: &'static str,
+        accepted: &'static str,
+    },
     #[error("{section}.{field} = {written}: expected a number in {default_unit} or a string \"VALUE UNIT\" such as \"{example}\"")]
     NotAValue { section: &'static str, field: String, written: String, default_unit: &'static str, example: String },
     #[error("{section}.{field} = {written}: must be {expected}")]
@@ -347,6 +356,9 @@ fn read_value(section: &'static str, name: &str, field: &Field, value: &toml::Va
             field: name.to_string(),
             written: written.clone(),
             unit: u.to_string(),
+            hint: super::units::case_variant(field.quantity, u).map_or(String::new(), |v| {
+                format!(" (unit symbols are case-sensitive: M is mega, m milli; {v} is written in lower case)")
+            }),
             default_unit: unit_or_none(field.unit),
             accepted: field.quantity.spelled(),
         })?,
@@ -357,6 +369,14 @@ fn read_value(section: &'static str, name: &str, field: &Field, value: &toml::Va
         let expected = if positive_needed { "a positive number" } else { "zero or a positive number" };
         return Err(SheetError::OutOfRange { section, field: name.to_string(), written, expected: format!("{expected} ({})", field.meaning) });
     }
+    if let Some((most, why)) = field.quantity.most()
+        && si > most
+    {
+        // The bound in the unit the value was written in.
+        let unit = unit.filter(|u| !u.is_empty()).unwrap_or(field.unit);
+        let expected = format!("at most {} {unit} ({why})", crate::io::number::short(most / scale));
+        return Err(SheetError::OutOfRange { section, field: name.to_string(), written, expected });
+    }
     Ok(Reading { si, written })
 }
 
@@ -365,7 +385,8 @@ fn unit_or_none(unit: &'static str) -> &'static str {
 }
 
 fn format_bare(v: f64, unit: &str) -> String {
-    if unit.is_empty() { format!("{v}") } else { format!("{v} {unit}") }
+    let v = crate::io::number::short(v);
+    if unit.is_empty() { v } else { format!("{v} {unit}") }
 }
 
 fn example_number(q: Quantity) -> &'static str {

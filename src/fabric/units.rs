@@ -8,7 +8,8 @@
 //! A sheet value is either a bare number, read in the standard's own unit for that field,
 //! or a string "VALUE UNIT" (`"137 g/m²"`, `"0.092 gf·cm²/cm"`, `"9 µN·m"`), read in any
 //! unit of the field's quantity listed here. Unit spellings are forgiving: `²`/`2`, `µ`/`u`,
-//! `·`/`.`/`*` and spaces are all accepted.
+//! `·`/`.`/`*` and spaces are all accepted; case is not (`Mg/cm²` is refused, not read as
+//! mg/cm²).
 
 use std::f64::consts::PI;
 
@@ -71,16 +72,35 @@ impl Quantity {
     /// Accepted unit spellings (normalised, see [`normalise_unit`]) and their factors to SI.
     pub fn units(self) -> &'static [(&'static str, f64)] {
         match self {
-            Quantity::ArealDensity => &[("mg/cm2", MG_PER_CM2), ("g/m2", G_PER_M2), ("gsm", G_PER_M2), ("kg/m2", 1.0), ("oz/yd2", OZ_PER_YD2)],
+            Quantity::ArealDensity => {
+                &[("mg/cm2", MG_PER_CM2), ("g/m2", G_PER_M2), ("gsm", G_PER_M2), ("GSM", G_PER_M2), ("kg/m2", 1.0), ("oz/yd2", OZ_PER_YD2)]
+            }
             Quantity::Length | Quantity::Roughness => &[("mm", 1e-3), ("cm", 1e-2), ("m", 1.0), ("um", 1e-6)],
-            Quantity::Bending => &[("gfcm2/cm", GF_CM2_PER_CM), ("gfcm", GF_CM2_PER_CM), ("unm", 1e-6), ("nm", 1.0), ("mgcm", MG_CM)],
-            Quantity::MomentPerWidth => &[("gfcm/cm", GF_CM_PER_CM), ("nm/m", 1.0), ("n", 1.0)],
-            Quantity::ShearRigidity => &[("gf/cmdeg", GF_PER_CM_DEG), ("gf/cm/deg", GF_PER_CM_DEG), ("gf/degcm", GF_PER_CM_DEG), ("n/m", 1.0), ("n/mrad", 1.0)],
-            Quantity::LoadPerWidth => &[("gf/cm", GF_PER_CM), ("n/m", 1.0)],
-            Quantity::EnergyPerArea => &[("gfcm/cm2", GF_CM_PER_CM2), ("j/m2", 1.0), ("n/m", 1.0)],
+            Quantity::Bending => &[("gfcm2/cm", GF_CM2_PER_CM), ("gfcm", GF_CM2_PER_CM), ("uNm", 1e-6), ("Nm", 1.0), ("mgcm", MG_CM)],
+            Quantity::MomentPerWidth => &[("gfcm/cm", GF_CM_PER_CM), ("Nm/m", 1.0), ("N", 1.0)],
+            Quantity::ShearRigidity => &[("gf/cmdeg", GF_PER_CM_DEG), ("gf/cm/deg", GF_PER_CM_DEG), ("gf/degcm", GF_PER_CM_DEG), ("N/m", 1.0), ("N/mrad", 1.0)],
+            Quantity::LoadPerWidth => &[("gf/cm", GF_PER_CM), ("N/m", 1.0)],
+            Quantity::EnergyPerArea => &[("gfcm/cm2", GF_CM_PER_CM2), ("J/m2", 1.0), ("N/m", 1.0)],
             Quantity::Percent => &[("%", 0.01)],
             Quantity::Ratio => &[("", 1.0), ("1", 1.0)],
             Quantity::Area => &[("mm2", 1e-6), ("m2", 1.0)],
+        }
+    }
+
+    /// The largest value of this quantity any fabric sheet can hold, SI, and why: the
+    /// ceilings the simulator's fabric checks use (a 1 cm steel plate stays below them), a
+    /// percentage of 100, a sample within the kilometre contact resolves. None where a
+    /// bound has no meaning (pure numbers).
+    pub fn most(self) -> Option<(f64, &'static str)> {
+        match self {
+            Quantity::ArealDensity => Some((1e3, "1000 kg/m²: a 1 cm steel plate weighs 79")),
+            Quantity::Bending => Some((1e6, "1e6 N·m: a 1 cm steel plate has 2e4")),
+            Quantity::MomentPerWidth | Quantity::ShearRigidity | Quantity::LoadPerWidth | Quantity::EnergyPerArea => {
+                Some((1e11, "1e11 in SI units: a 1 cm steel plate has 2e9 N/m"))
+            }
+            Quantity::Percent => Some((1.0, "100 %: a woven has broken long before")),
+            Quantity::Length | Quantity::Roughness | Quantity::Area => Some((1e3, "a kilometre or a square kilometre, beyond any specimen")),
+            Quantity::Ratio => None,
         }
     }
 
@@ -101,16 +121,18 @@ impl Quantity {
     }
 }
 
-/// Lower-cases a unit and drops the characters people write differently: spaces, `·`,
-/// `.`, `*`, brackets; `²`/`³` become `2`/`3` and `µ`/`μ` becomes `u`.
+/// Drops the characters people write differently: spaces, `·`, `.`, `*`, brackets; `²`/`³`
+/// become `2`/`3`, `µ`/`μ` becomes `u` and `°` becomes `deg`. Case is kept: unit symbols
+/// are case-sensitive (`Mg` is a megagram, `mg` a milligram; 10⁹ apart).
 pub fn normalise_unit(unit: &str) -> String {
     unit.chars()
         .filter_map(|c| match c {
             ' ' | '·' | '⋅' | '.' | '*' | '(' | ')' | '\t' => None,
-            '²' => Some('2'),
-            '³' => Some('3'),
-            'µ' | 'μ' => Some('u'),
-            c => Some(c.to_ascii_lowercase()),
+            '²' => Some("2".to_string()),
+            '³' => Some("3".to_string()),
+            'µ' | 'μ' => Some("u".to_string()),
+            '°' => Some("deg".to_string()),
+            c => Some(c.to_string()),
         })
         .collect()
 }
@@ -132,6 +154,13 @@ pub fn split_value(text: &str) -> Option<(f64, &str)> {
 pub fn factor(quantity: Quantity, unit: &str) -> Option<f64> {
     let unit = normalise_unit(unit);
     quantity.units().iter().find(|(u, _)| *u == unit).map(|(_, f)| *f)
+}
+
+/// The unit of `quantity` that `unit` would be with its letters in another case (`Mg/cm²`
+/// for `mg/cm²`), for the hint in the error that refuses it.
+pub fn case_variant(quantity: Quantity, unit: &str) -> Option<&'static str> {
+    let unit = normalise_unit(unit);
+    quantity.units().iter().find(|(u, _)| u.eq_ignore_ascii_case(&unit)).map(|(u, _)| *u)
 }
 
 #[cfg(test)]
@@ -166,5 +195,9 @@ mod tests {
         assert_eq!(factor(Quantity::ArealDensity, "oz/yd²"), Some(OZ_PER_YD2));
         assert_eq!(factor(Quantity::ArealDensity, "lb/ft2"), None);
         assert_eq!(factor(Quantity::Bending, "g/m2"), None, "a unit of another quantity is refused");
+        assert_eq!(factor(Quantity::ArealDensity, "Mg/cm²"), None, "unit symbols are case-sensitive");
+        assert_eq!(case_variant(Quantity::ArealDensity, "Mg/cm²"), Some("mg/cm2"));
+        assert_eq!(factor(Quantity::ShearRigidity, "n/m"), None);
+        assert_eq!(factor(Quantity::ShearRigidity, "gf/(cm·°)"), Some(GF_PER_CM_DEG));
     }
 }

@@ -198,7 +198,9 @@ pub fn save_screenshot(scene: &Scene, shot: &Screenshot) -> Result<(), RenderErr
     let camera = shot.camera(&frame);
     let options = RenderOptions { wireframe: shot.wireframe, ..RenderOptions::default() };
     let image = Headless::new()?.render(&frame, &camera, &options, shot.size)?;
-    image.save_with_format(&shot.path, image::ImageFormat::Png).map_err(|e| RenderError::Write { path: shot.path.display().to_string(), message: e.to_string() })
+    // Written whole, with the mark by which a later run may replace it (src/io/write.rs).
+    crate::io::write::png_file(&shot.path, image.as_raw(), image.dimensions(), 4, crate::io::write::Effort::Balanced)
+        .map_err(|message| RenderError::Write { path: shot.path.display().to_string(), message })
 }
 
 #[cfg(test)]

@@ -136,7 +136,9 @@ pub struct ShearMeasures {
     pub shear_angle_deg: f64,
     /// Largest normal deflection in the central region, m.
     pub wrinkle_amplitude: f64,
-    /// Direction of the wrinkle crests from the warp, degrees in [0, 180).
+    /// Direction of the wrinkle crests from the warp, degrees in [0, 180); not measured
+    /// (NaN, left out of the JSON) where there are no wrinkles (`possible::judge`).
+    #[serde(default = "not_measured", skip_serializing_if = "is_not_measured")]
     pub wrinkle_angle_deg: f64,
     /// Wrinkles crossed by a line through the centre across the crests.
     pub wrinkle_count: usize,
@@ -147,7 +149,10 @@ pub struct ShearMeasures {
 /// The Cusick drape (paper Fig. 6; BS 5058) and other drapes over a support.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct DrapeMeasures {
-    /// (A_shadow − A_support) / (A_specimen − A_support).
+    /// (A_shadow − A_support) / (A_specimen − A_support); not measured (NaN, left out of
+    /// the JSON) where it falls outside [0, 1], a cloth that has not draped
+    /// (`possible::judge`).
+    #[serde(default = "not_measured", skip_serializing_if = "is_not_measured")]
     pub drape_coefficient: f64,
     /// (t s, drape coefficient, nodes) while the cloth drapes, at most about a hundred rows.
     pub history: Vec<(f64, f64, usize)>,
@@ -164,6 +169,16 @@ pub struct DrapeMeasures {
     pub specimen_area: f64,
     /// Area of the support (pedestal disc or table top), m².
     pub support_area: f64,
+}
+
+/// A measure that was not taken: NaN in memory, absent from the JSON (a null would pass
+/// for a number).
+fn not_measured() -> f64 {
+    f64::NAN
+}
+
+fn is_not_measured(value: &f64) -> bool {
+    value.is_nan()
 }
 
 /// One number among a rig's measures: a real value or a count, kept apart so that text

@@ -40,13 +40,46 @@ pub fn estimate_bytes(vertices: usize, choice: PreconditionerChoice) -> f64 {
     BASE_BYTES + per_vertex * n
 }
 
-/// Memory the system can give this process now (MemAvailable in /proc/meminfo), bytes;
-/// `None` where that is not known (then nothing is refused).
+/// Memory the system can give this process now, bytes: the least of MemAvailable in
+/// /proc/meminfo, the address space left under the process's limit (`ulimit -v`) and the
+/// room left in its control group (`memory.max`); `None` where none is known (then
+/// nothing is refused).
 pub fn available_bytes() -> Option<f64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024.0)
+    [system_available(), address_space_left(), cgroup_left()].into_iter().flatten().reduce(f64::min)
+}
+
+/// A number of kB on the line of /proc's `file` that starts with `key`.
+fn proc_kb(file: &str, key: &str) -> Option<f64> {
+    let info = std::fs::read_to_string(file).ok()?;
+    let line = info.lines().find(|l| l.starts_with(key))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
+fn system_available() -> Option<f64> {
+    proc_kb("/proc/meminfo", "MemAvailable:").map(|kb| kb * 1024.0)
+}
+
+/// The soft address-space limit less what the process has mapped already.
+fn address_space_left() -> Option<f64> {
+    #[cfg(unix)]
+    {
+        let mut limit = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+        // SAFETY: getrlimit writes the limit into the struct it is given.
+        if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut limit) } != 0 || limit.rlim_cur == libc::RLIM_INFINITY {
+            return None;
+        }
+        let mapped = proc_kb("/proc/self/status", "VmSize:").map_or(0.0, |kb| kb * 1024.0);
+        Some((limit.rlim_cur as f64 - mapped).max(0.0))
+    }
+    #[cfg(not(unix))]
+    None
+}
+
+/// The control group's memory.max less its memory.current (cgroup v2, the group the
+/// process sees at /sys/fs/cgroup).
+fn cgroup_left() -> Option<f64> {
+    let read = |name: &str| std::fs::read_to_string(format!("/sys/fs/cgroup/{name}")).ok()?.trim().parse::<f64>().ok();
+    Some((read("memory.max")? - read("memory.current").unwrap_or(0.0)).max(0.0))
 }
 
 /// Refuses a mesh of `vertices` vertices at edge length `edge` (m) whose run would need
@@ -66,7 +99,7 @@ pub fn check(vertices: usize, edge: f64, choice: PreconditionerChoice, available
     let fits = edge * (vertices as f64 / lo.max(1) as f64).sqrt();
     Err(format!(
         "mesh.edge_length = {edge:?} m gives {vertices} vertices, whose run needs about {:.1} GB (the measured estimate of \
-         docs/robustness.md), more than the {:.1} GB this machine has available; use mesh.edge_length = {:.3e} m or more",
+         docs/robustness.md), more than the {:.1} GB available to this run (free memory, ulimit -v or the control group's limit); use mesh.edge_length = {:.3e} m or more",
         need / 1e9,
         available / 1e9,
         fits * 1.001

@@ -4,9 +4,11 @@
 pub mod drape;
 pub mod garment;
 pub mod levels;
+pub mod load;
 pub mod measures;
 pub mod memory;
 pub mod preset;
+pub mod possible;
 pub mod props;
 pub mod rigs;
 pub mod run;

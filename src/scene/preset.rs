@@ -6,12 +6,15 @@
 //! fabric file. Overrides given with `--set KEY=VALUE` are applied to the scene before the
 //! fabric is merged, so they win over both. Unknown keys are errors, so a typo fails loudly.
 
+use crate::io::read::{FileKind, parse_toml, read_text};
 use crate::sim::contact::ContactSettings;
 use crate::sim::{AdaptiveStep, Fabric, FabricError, FabricPoints, IntegratorKind, NewtonSettings, Pattern};
 use serde::de::{DeserializeSeed, IntoDeserializer, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
+
+pub use super::load::{RunFlags, load_scene, load_scene_with};
 
 /// A preset file bundled into the binary.
 pub struct Bundled {
@@ -37,9 +40,9 @@ pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", 
 /// Why a preset could not be loaded. Every message names the file and, where it can, the key.
 #[derive(Debug, Error)]
 pub enum PresetError {
-    #[error("cannot read {path}: {source}")]
-    Io { path: String, source: std::io::Error },
-    #[error("{file}: not valid TOML: {message}")]
+    #[error("{key}: {source}")]
+    Read { key: &'static str, source: crate::io::read::ReadError },
+    #[error("{file}: {message}")]
     Syntax { file: String, message: String },
     #[error("{file}: {message}")]
     Invalid { file: String, message: String },
@@ -388,15 +391,19 @@ pub enum ShearKinematics {
     Simple,
 }
 
-fn looks_like_path(spec: &str) -> bool {
+pub(super) fn looks_like_path(spec: &str) -> bool {
     spec.contains('/') || spec.contains('\\') || spec.ends_with(".toml")
 }
 
-fn read_preset(kind: &'static str, spec: &str, list: &'static [Bundled], base: Option<&Path>) -> Result<(String, String), PresetError> {
+/// Reads a bundled preset by name or a file by path (relative to `base` where that holds
+/// it) through the bounded reader, and parses it; returns the table and the name errors
+/// give the file.
+pub(super) fn read_table(kind: &'static str, spec: &str, list: &'static [Bundled], base: Option<&Path>) -> Result<(toml::Table, String), PresetError> {
     let bundled = list.iter().find(|b| b.name == spec);
     if let (Some(b), false) = (bundled, looks_like_path(spec)) {
         let dir = if kind == "fabric" { "fabrics/" } else { "" };
-        return Ok((b.text.to_string(), format!("presets/{dir}{}.toml (bundled)", b.name)));
+        let file = format!("presets/{dir}{}.toml (bundled)", b.name);
+        return Ok((parse_table(b.text, &file)?, file));
     }
     let mut path = PathBuf::from(spec);
     if let (true, Some(base)) = (path.is_relative(), base) {
@@ -409,12 +416,30 @@ fn read_preset(kind: &'static str, spec: &str, list: &'static [Bundled], base: O
         let available = list.iter().map(|b| b.name).collect::<Vec<_>>().join(", ");
         return Err(PresetError::Unknown { kind, name: spec.to_string(), available });
     }
-    let text = std::fs::read_to_string(&path).map_err(|source| PresetError::Io { path: path.display().to_string(), source })?;
-    Ok((text, path.display().to_string()))
+    let (file_kind, key) = if kind == "fabric" { (FileKind::Fabric, "fabric.preset") } else { (FileKind::Scene, "scene") };
+    let text = read_text(&path, file_kind).map_err(|source| PresetError::Read { key, source })?;
+    let file = path.display().to_string();
+    let table = parse_toml(&text, Some(&path), file_kind).map_err(|message| PresetError::Syntax { file: file.clone(), message })?;
+    if kind == "fabric" {
+        refuse_fabric_preset(&table).map_err(|message| PresetError::Invalid { file: file.clone(), message })?;
+    }
+    Ok((table, file))
 }
 
-fn parse_table(text: &str, file: &str) -> Result<toml::Table, PresetError> {
-    text.parse::<toml::Table>().map_err(|e| PresetError::Syntax { file: file.to_string(), message: e.to_string() })
+/// A fabric file stands alone: `preset` (a fabric to start from) is read only in a scene's
+/// `[fabric]` table, so one in a fabric file would be silently ignored.
+pub fn refuse_fabric_preset(table: &toml::Table) -> Result<(), String> {
+    match table.get("preset") {
+        None => Ok(()),
+        Some(preset) => Err(format!(
+            "preset = {preset}: a fabric file cannot start from another fabric (only a scene's [fabric] table can); \
+             remove the key and give the fabric's values, or name {preset} in the scene's fabric.preset and set the keys that differ under [fabric]"
+        )),
+    }
+}
+
+pub(super) fn parse_table(text: &str, file: &str) -> Result<toml::Table, PresetError> {
+    parse_toml(text, None, FileKind::Scene).map_err(|message| PresetError::Syntax { file: file.to_string(), message })
 }
 
 /// Parses `KEY=VALUE`; VALUE is read as a TOML value (number, array, boolean, quoted
@@ -435,7 +460,7 @@ pub fn parse_override(text: &str) -> Result<(Vec<String>, toml::Value), PresetEr
     Ok((path, parsed))
 }
 
-fn apply_override(table: &mut toml::Table, path: &[String], value: toml::Value) -> Result<(), String> {
+pub(super) fn apply_override(table: &mut toml::Table, path: &[String], value: toml::Value) -> Result<(), String> {
     let (last, parents) = path.split_last().expect("non-empty key");
     let mut current = table;
     for part in parents {
@@ -444,178 +469,6 @@ fn apply_override(table: &mut toml::Table, path: &[String], value: toml::Value) 
     }
     current.insert(last.clone(), value);
     Ok(())
-}
-
-/// Where each value of a scene came from, so that an error names the file or the `--set`
-/// that gave the bad value.
-struct Sources {
-    scene_file: String,
-    /// The fabric file named by `fabric.preset`, and the keys the scene's own `[fabric]`
-    /// table gives (those are the scene file's).
-    fabric_file: Option<String>,
-    scene_fabric_keys: Vec<String>,
-    /// Each `--set` as typed, with its key.
-    overrides: Vec<(Vec<String>, String)>,
-    /// The scene and fabric files' values before the overrides, to quote as an example.
-    original: toml::Table,
-}
-
-impl Sources {
-    /// The file or `--set` a bad value at `key` (dotted, array indices dropped) came from.
-    fn blame(&self, key: &[String]) -> String {
-        let overlaps = |path: &[String]| path.iter().zip(key).all(|(a, b)| a == b);
-        if let Some((_, text)) = self.overrides.iter().rev().find(|(path, _)| overlaps(path)) {
-            return format!("--set {text}");
-        }
-        match (&self.fabric_file, key) {
-            (Some(fabric_file), [section, field, ..]) if section == "fabric" && !self.scene_fabric_keys.contains(field) => fabric_file.clone(),
-            _ => self.scene_file.clone(),
-        }
-    }
-
-    /// The value the files give at `key`, as TOML, if they give one.
-    fn original(&self, key: &[String]) -> Option<String> {
-        let (last, parents) = key.split_last()?;
-        let mut table = &self.original;
-        for part in parents {
-            table = table.get(part)?.as_table()?;
-        }
-        table.get(last).map(|v| v.to_string())
-    }
-
-    fn invalid(&self, key: &[String], message: String) -> PresetError {
-        PresetError::Invalid { file: self.blame(key), message }
-    }
-}
-
-/// A dotted key split into its parts, array indices (`props[0]`) dropped.
-fn key_parts(key: &str) -> Vec<String> {
-    key.split('.').map(|part| part.split('[').next().unwrap_or("").to_string()).filter(|part| !part.is_empty()).collect()
-}
-
-/// serde's message for a value of the wrong type or length, in the words of a scene file,
-/// led by the key.
-fn type_error(key: &str, message: &str, example: Option<String>) -> String {
-    let words = |s: &str| {
-        s.replace("f64", "a number")
-            .replace("floating point", "the number")
-            .replace("u64", "a whole number")
-            .replace("usize", "a whole number")
-            .replace("integer", "the whole number")
-            .replace("string", "the text")
-            .replace("sequence", "an array")
-    };
-    let message = message.trim();
-    // serde's "invalid type: X, expected Y" (and value, length) read as "must be Y, got X".
-    let reworded = ["invalid type: ", "invalid value: ", "invalid length "].iter().find_map(|lead| {
-        let (got, expected) = message.strip_prefix(lead)?.split_once(", expected ")?;
-        let got = if *lead == "invalid length " { format!("{got} values") } else { words(got) };
-        Some(format!("must be {}, got {got}", words(expected)))
-    });
-    let text = match (reworded, key.is_empty()) {
-        (Some(text), false) => format!("{key} {text}"),
-        (None, false) => format!("{key}: {message}"),
-        (Some(text), true) => text,
-        (None, true) => message.to_string(),
-    };
-    match example {
-        Some(example) if !key.is_empty() => format!("{text}; the file has {key} = {example}"),
-        _ => text,
-    }
-}
-
-/// Deserialises `table` as a `T`, an error naming the key that failed (by its path, which
-/// plain serde leaves out).
-fn deserialize_named<T: serde::de::DeserializeOwned>(table: toml::Table) -> Result<T, (Vec<String>, String, String)> {
-    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
-        let path = e.path().to_string();
-        let key = if path == "." { String::new() } else { path };
-        (key_parts(&key), key, e.into_inner().message().to_string())
-    })
-}
-
-/// Loads a scene by bundled name or path, applies `overrides` (`KEY=VALUE`), merges its
-/// fabric and checks everything: a value out of range is refused here, with the file or
-/// the `--set` that gave it, its key and how to fix it.
-pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, String), PresetError> {
-    let (text, file) = read_preset("scene", spec, SCENES, None)?;
-    let base = if looks_like_path(spec) || Path::new(spec).exists() { Path::new(spec).parent().map(Path::to_path_buf) } else { None };
-    let mut table = parse_table(&text, &file)?;
-    let scene_fabric_keys = table.get("fabric").and_then(|v| v.as_table()).map(|t| t.keys().cloned().collect()).unwrap_or_default();
-    let mut sources = Sources { scene_file: file.clone(), fabric_file: None, scene_fabric_keys, overrides: Vec::new(), original: toml::Table::new() };
-    let mut fabric_table = None;
-    // The fabric file named in the scene file, for the original values.
-    if let Some(name) = table.get("fabric").and_then(|f| f.get("preset")).and_then(|v| v.as_str()) {
-        let (fabric_text, fabric_file) = read_preset("fabric", name, FABRICS, base.as_deref())?;
-        fabric_table = Some((name.to_string(), parse_table(&fabric_text, &fabric_file)?, fabric_file));
-    }
-    sources.original = merge_fabric(table.clone(), fabric_table.as_ref().map(|f| f.1.clone()));
-    for o in overrides {
-        let (path, value) = parse_override(o)?;
-        apply_override(&mut table, &path, value).map_err(|m| PresetError::BadOverride { text: o.clone(), message: m })?;
-        sources.overrides.push((path, o.clone()));
-    }
-    let preset = table.get("fabric").and_then(|f| f.get("preset"));
-    if let Some(preset) = preset {
-        let name = preset.as_str().ok_or_else(|| sources.invalid(&key_parts("fabric.preset"), format!("fabric.preset must be a fabric name or file in quotes, got {preset}")))?;
-        if fabric_table.as_ref().is_none_or(|f| f.0 != name) {
-            let (fabric_text, fabric_file) = read_preset("fabric", name, FABRICS, base.as_deref())?;
-            fabric_table = Some((name.to_string(), parse_table(&fabric_text, &fabric_file)?, fabric_file));
-        }
-    } else {
-        fabric_table = None;
-    }
-    if let Some((_, t, fabric_file)) = &mut fabric_table {
-        // Sheet fields the scene or a `--set` changes are converted with the file's sheet.
-        if let Some(scene_fabric) = table.get_mut("fabric").and_then(|v| v.as_table_mut()) {
-            crate::fabric::merge_scene_sheets(t, scene_fabric);
-        }
-        expand_sheets(t, fabric_file)?;
-        // The fabric file's own fields are checked here so errors name that file.
-        deserialize_named::<FabricConfig>(t.clone()).map_err(|(_, key, message)| {
-            let key = if key.is_empty() { key } else { format!("fabric.{key}") };
-            PresetError::Invalid { file: fabric_file.clone(), message: type_error(&key, &message, None) }
-        })?;
-        sources.fabric_file = Some(fabric_file.clone());
-    }
-    let mut table = merge_fabric(table, fabric_table.map(|f| f.1));
-    // A scene without a fabric file may carry its own sheets.
-    if let Some(fabric) = table.get_mut("fabric").and_then(|v| v.as_table_mut()) {
-        expand_sheets(fabric, &file)?;
-    }
-    let mut config: SceneConfig = deserialize_named(table).map_err(|(parts, key, message)| {
-        let example = sources.original(&parts);
-        sources.invalid(&parts, type_error(&key, &message, example))
-    })?;
-    config.base_dir = base;
-    super::validate::check_scene(&config).map_err(|e| sources.invalid(&key_parts(&e.key), e.message))?;
-    Ok((config, file))
-}
-
-/// Turns a fabric table's measurement sheets (`[kes]`, `[fast]`, `[cantilever]`) into
-/// fabric keys (crate::fabric); the defaults it had to use are reported on stderr.
-fn expand_sheets(table: &mut toml::Table, file: &str) -> Result<(), PresetError> {
-    let warnings =
-        crate::fabric::expand_sheets(table).map_err(|e| PresetError::Invalid { file: file.to_string(), message: e.to_string() })?;
-    for w in warnings {
-        eprintln!("warning: {file}: {w}");
-    }
-    Ok(())
-}
-
-/// The scene's table with its `[fabric]` keys laid over the fabric file's.
-fn merge_fabric(mut table: toml::Table, fabric_file: Option<toml::Table>) -> toml::Table {
-    let scene_fabric = table.remove("fabric").and_then(|v| v.as_table().cloned()).unwrap_or_default();
-    let mut fabric = fabric_file.unwrap_or_default();
-    let preset = scene_fabric.get("preset").cloned();
-    for (k, v) in scene_fabric {
-        fabric.insert(k, v);
-    }
-    if let Some(p) = preset {
-        fabric.insert("preset".into(), p);
-    }
-    table.insert("fabric".into(), toml::Value::Table(fabric));
-    table
 }
 
 impl SceneConfig {
@@ -652,7 +505,7 @@ mod tests {
         }
         for f in FABRICS {
             let mut t = parse_table(f.text, f.name).unwrap();
-            expand_sheets(&mut t, f.name).unwrap_or_else(|e| panic!("{}: {e}", f.name));
+            crate::fabric::expand_sheets(&mut t).unwrap_or_else(|e| panic!("{}: {e}", f.name));
             let c: FabricConfig = t.try_into().unwrap_or_else(|e| panic!("{}: {e}", f.name));
             c.to_fabric().unwrap_or_else(|e| panic!("{}: {e}", f.name));
         }

@@ -4,7 +4,9 @@
 use super::preset::{PropConfig, PropKind};
 use crate::sim::contact::{MAX_REACH, Prop, PropShape};
 use glam::{DQuat, DVec3, EulerRot};
-use std::path::Path;
+use crate::io::number::short;
+use crate::io::read::{FileKind, quotable, read_text};
+use std::path::{Path, PathBuf};
 
 /// An asset file bundled into the binary.
 pub struct Asset {
@@ -35,7 +37,7 @@ fn build_prop(index: usize, c: &PropConfig, base_dir: Option<&Path>) -> Result<P
             let file = c.file.as_deref().ok_or_else(|| format!("prop '{name}': a mesh needs `file`, an OBJ path"))?;
             let scale = c.scale.unwrap_or(1.0);
             if !(scale.is_finite() && scale > 0.0 && scale <= MAX_REACH) {
-                return Err(format!("prop '{name}': scale must be a positive number up to {MAX_REACH}, got {scale:?}"));
+                return Err(format!("prop '{name}': scale must be a positive number up to {MAX_REACH}, got {}", short(scale)));
             }
             let (vertices, triangles) = load_obj(file, base_dir, scale).map_err(|e| format!("prop '{name}': {e}"))?;
             PropShape::Mesh { vertices: vertices.into_iter().map(|v| v * scale).collect(), triangles }
@@ -49,20 +51,18 @@ fn build_prop(index: usize, c: &PropConfig, base_dir: Option<&Path>) -> Result<P
 /// Reads an OBJ (all its objects, triangulated) from a bundled asset or a file whose
 /// coordinates will be multiplied by `scale`.
 pub fn load_obj(file: &str, base_dir: Option<&Path>, scale: f64) -> Result<(Vec<DVec3>, Vec<[u32; 3]>), String> {
-    let text = match ASSETS.iter().find(|a| a.name == file) {
-        Some(asset) => asset.text.to_string(),
+    let (text, quotable) = match ASSETS.iter().find(|a| a.name == file) {
+        Some(asset) => (asset.text.to_string(), true),
         None => {
-            let mut path = Path::new(file).to_path_buf();
-            if let (true, Some(base)) = (path.is_relative(), base_dir) {
-                path = base.join(path);
-            }
-            std::fs::read_to_string(&path).map_err(|e| {
+            let path = obj_path(file, base_dir);
+            let text = read_text(&path, FileKind::Obj).map_err(|e| {
                 let bundled: Vec<_> = ASSETS.iter().map(|a| a.name).collect();
-                format!("cannot read {}: {e} (bundled meshes: {})", path.display(), bundled.join(", "))
-            })?
+                format!("{e} (bundled meshes: {})", bundled.join(", "))
+            })?;
+            (text, quotable(&path, FileKind::Obj))
         }
     };
-    check_vertices(file, &text, scale)?;
+    check_vertices(file, &text, scale, quotable)?;
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Ok(Default::default()))
         .map_err(|e| format!("{file} is not a readable OBJ: {e}"))?;
@@ -78,21 +78,36 @@ pub fn load_obj(file: &str, base_dir: Option<&Path>, scale: f64) -> Result<(Vec<
     Ok((vertices, triangles))
 }
 
+/// The file a mesh prop's `file` names on disk: relative to the scene's folder where the
+/// scene is a file.
+pub fn obj_path(file: &str, base_dir: Option<&Path>) -> PathBuf {
+    let path = Path::new(file);
+    match base_dir {
+        Some(base) if path.is_relative() => base.join(path),
+        _ => path.to_path_buf(),
+    }
+}
+
 /// Checks every vertex line (`v x y z`) before the OBJ reader sees it, so that a bad
 /// coordinate is named by its line: the reader takes `nan`, `inf` and numbers past f32's
 /// range (1e39) without complaint, and such a prop would silently drop out of contact.
-fn check_vertices(file: &str, text: &str, scale: f64) -> Result<(), String> {
+/// The word is quoted only from a file named FILE.obj (`quotable`).
+fn check_vertices(file: &str, text: &str, scale: f64, quotable: bool) -> Result<(), String> {
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         if words.next() != Some("v") {
             continue;
         }
         for word in words.take(3) {
-            let value: f64 = word.parse().map_err(|_| format!("{file}:{}: '{word}' is not a number", number + 1))?;
+            let value: f64 = word.parse().map_err(|_| {
+                if quotable { format!("{file}:{}: '{word}' is not a number", number + 1) } else { format!("{file}:{}: not an OBJ mesh (a vertex line without numbers); name the mesh FILE.obj", number + 1) }
+            })?;
             if !(value * scale).is_finite() || (value * scale).abs() > MAX_REACH {
                 return Err(format!(
-                    "{file}:{}: coordinate {word} (× scale {scale}) must be finite and within {MAX_REACH} m of the origin; fix the vertex or the prop's scale",
-                    number + 1
+                    "{file}:{}: coordinate {} (× scale {}) must be finite and within {MAX_REACH} m of the origin; fix the vertex or the prop's scale",
+                    number + 1,
+                    if word.len() <= 12 { word.to_string() } else { short(value) },
+                    short(scale)
                 ));
             }
         }

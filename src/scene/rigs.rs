@@ -146,7 +146,7 @@ impl Rig {
                 let fixed = vertices_where(&rest, |p| p.x < ON_EDGE);
                 let moving = vertices_where(&rest, |p| p.x > length - ON_EDGE);
                 let speed = t.speed.expect("checked when loading");
-                let stop = t.max_strain.expect("checked when loading") * length / speed;
+                let stop = super::possible::motion_time(config).expect("checked when loading").1;
                 pin_all(model, &fixed);
                 model.drive(&moving, x, Motion::Linear { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop });
                 let columns = Columns::new(&rest, length, h);
@@ -193,7 +193,7 @@ impl Rig {
                 let left = vertices_where(&rest, |p| p.x < ON_EDGE);
                 let right = vertices_where(&rest, |p| p.x > length - ON_EDGE);
                 let speed = t.speed.expect("checked when loading");
-                let stop = t.end_shortening.expect("checked when loading") * length / speed;
+                let stop = super::possible::motion_time(config).expect("checked when loading").1;
                 // Both ends move, each at half the approach speed, so the midspan stays put.
                 model.drive(&left, x, Motion::Linear { velocity: DVec3::new(0.5 * speed, 0.0, 0.0), start: 0.0, stop });
                 model.drive(&right, x, Motion::Linear { velocity: DVec3::new(-0.5 * speed, 0.0, 0.0), start: 0.0, stop });
@@ -205,15 +205,13 @@ impl Rig {
                 let clamped = vertices_where(&rest, |p| p.y < ON_EDGE);
                 let moving = vertices_where(&rest, |p| p.y > width - ON_EDGE);
                 let speed = t.speed.expect("checked when loading");
-                let angle = t.shear_angle_deg.expect("checked when loading").to_radians();
+                let stop = super::possible::motion_time(config).expect("checked when loading").1;
                 pin_all(model, &clamped);
                 let motion = match t.shear_kinematics.unwrap_or_default() {
                     // The moving grip slides along the warp; the gap stays, so the cross yarns stretch.
-                    ShearKinematics::Simple => {
-                        Motion::Linear { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop: width * angle.tan() / speed }
-                    }
+                    ShearKinematics::Simple => Motion::Linear { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop },
                     // The moving grip swings on the cross yarns, which keep their length.
-                    ShearKinematics::Trellis => Motion::Swing { radius: width, angular_speed: speed / width, stop: angle * width / speed },
+                    ShearKinematics::Trellis => Motion::Swing { radius: width, angular_speed: speed / width, stop },
                 };
                 model.drive(&moving, x, motion);
                 Rig::Shear(Shear { moving, width, length })

@@ -75,6 +75,10 @@ pub struct Metrics {
     #[serde(deserialize_with = "step_timings")]
     pub step_time: StepTimings,
     pub measures: Measures,
+    /// What the run could not measure or did not reach, one sentence each
+    /// (`possible::judge`): a measure left out of `measures` is explained here.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// What the contact handling had to do over a run (`Metrics::contact_events`).
@@ -365,7 +369,10 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         peak_memory_bytes: peak_memory_bytes(),
         step_time,
         measures: scene.measures(),
+        notes: Vec::new(),
     };
+    let mut metrics = metrics;
+    super::possible::judge(scene, &mut metrics, duration);
     (metrics, error)
 }
 

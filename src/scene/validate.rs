@@ -7,6 +7,7 @@
 //! support larger than the specimen), never merely because it is unusual.
 
 use super::preset::{SceneConfig, SceneKind};
+use crate::io::number::short;
 use crate::sim::contact::MAX_REACH;
 use crate::sim::mesh::{MAX_VERTICES, planned_vertices};
 
@@ -15,25 +16,29 @@ use crate::sim::mesh::{MAX_VERTICES, planned_vertices};
 pub struct Invalid {
     pub key: String,
     pub message: String,
+    /// Other keys the refused value was weighed against: where the user set one of them
+    /// (`--set test.speed=1e-300` against the scene's `test.max_strain`), the refusal is
+    /// traced to it.
+    pub also: Vec<String>,
 }
 
 pub(super) fn invalid(key: &str, message: String) -> Invalid {
-    Invalid { key: key.to_string(), message }
+    Invalid { key: key.to_string(), message, also: Vec::new() }
 }
 
 pub(super) fn positive(key: &str, v: f64) -> Result<f64, Invalid> {
-    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be a positive number, got {v:?}"))) }
+    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be a positive number, got {}", short(v)))) }
 }
 
 pub(super) fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
-    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be zero or a positive number, got {v:?}"))) }
+    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be zero or a positive number, got {}", short(v)))) }
 }
 
 /// Positive and at most `max` (`why` says what the bound is).
 fn positive_at_most(key: &str, v: f64, max: f64, why: &str) -> Result<f64, Invalid> {
     positive(key, v)?;
     if v > max {
-        return Err(invalid(key, format!("{key} = {v:?} is more than {max:?} ({why})")));
+        return Err(invalid(key, format!("{key} = {} is more than {} ({why})", short(v), short(max))));
     }
     Ok(v)
 }
@@ -54,11 +59,15 @@ fn point(key: &str, p: [f64; 3]) -> Result<(), Invalid> {
 pub fn check_step_count(key: &str, duration: f64, dt: f64, max_steps: u64) -> Result<(), Invalid> {
     let needed = (duration / dt).ceil();
     if needed > max_steps as f64 {
+        // A bound past 1e15 steps would run for millennia: not worth offering.
+        let raise = if needed < 1e15 { format!(", or raise the bound (--max-steps {needed:.0})") } else { String::new() };
         return Err(invalid(
             key,
             format!(
-                "{key} = {duration:?} s at solver.dt = {dt:?} s needs {needed:.3e} steps, more than scene.max_steps = {max_steps}: \
-                 use a larger solver.dt or a shorter duration, or raise the bound (--max-steps {needed:.0})"
+                "{key} = {} s at solver.dt = {} s needs {needed:.3e} steps, more than scene.max_steps = {max_steps}: \
+                 use a larger solver.dt or a shorter duration{raise}",
+                short(duration),
+                short(dt)
             ),
         ));
     }
@@ -84,8 +93,19 @@ const TEST_KEYS: &[(&str, &[SceneKind])] = {
 
 /// Checks a whole scene (see the module's doc).
 pub fn check_scene(c: &SceneConfig) -> Result<(), Invalid> {
+    check_scene_for(c, None)
+}
+
+/// [`check_scene`] for a run of `run_duration` seconds (`rosette run --duration`) instead
+/// of the scene's own: the step count and the step's length are checked against it, and
+/// named by its flag.
+pub fn check_scene_for(c: &SceneConfig, run_duration: Option<f64>) -> Result<(), Invalid> {
     let s = &c.scene;
     positive("scene.duration", s.duration)?;
+    let run = match run_duration {
+        Some(d) => RunLength { seconds: positive("--duration", d)?, key: "--duration" },
+        None => RunLength { seconds: s.duration, key: "scene.duration" },
+    };
     positive("scene.settle_window", s.settle_window)?;
     if let Some(v) = s.settle_speed {
         positive("scene.settle_speed", v)?;
@@ -96,8 +116,8 @@ pub fn check_scene(c: &SceneConfig) -> Result<(), Invalid> {
     if s.max_steps == 0 {
         return Err(invalid("scene.max_steps", "scene.max_steps must be at least 1".into()));
     }
-    check_solver(c)?;
-    check_step_count("scene.duration", s.duration, c.solver.dt, s.max_steps)?;
+    check_solver(c, &run)?;
+    check_step_count(run.key, run.seconds, c.solver.dt, s.max_steps)?;
     let extent = if c.scene.kind == SceneKind::Garment {
         super::garment::check(c)?
     } else {
@@ -109,6 +129,7 @@ pub fn check_scene(c: &SceneConfig) -> Result<(), Invalid> {
     check_test(c, extent)?;
     check_contact(c, extent)?;
     for (i, p) in c.props.iter().enumerate() {
+        check_prop_keys(i, p)?;
         point(&format!("props[{i}].position"), p.position)?;
         if p.rotation_deg.iter().any(|a| !(a.is_finite() && a.abs() <= 360.0)) {
             return Err(invalid(&format!("props[{i}].rotation_deg"), format!("props[{i}].rotation_deg must be three angles between -360 and 360 degrees, got {:?}", p.rotation_deg)));
@@ -117,18 +138,49 @@ pub fn check_scene(c: &SceneConfig) -> Result<(), Invalid> {
     Ok(())
 }
 
-fn check_solver(c: &SceneConfig) -> Result<(), Invalid> {
-    let (solver, duration) = (&c.solver, c.scene.duration);
+/// How long the run is asked to be, and the key or flag that says so.
+struct RunLength {
+    seconds: f64,
+    key: &'static str,
+}
+
+/// Refuses a size key the prop's shape does not read (a sphere's `height` would be
+/// silently ignored).
+fn check_prop_keys(i: usize, p: &super::preset::PropConfig) -> Result<(), Invalid> {
+    use super::preset::PropKind;
+    let reads: &[&str] = match p.shape {
+        PropKind::Ground => &[],
+        PropKind::Box => &["size"],
+        PropKind::Cylinder => &["radius", "height"],
+        PropKind::Sphere => &["radius"],
+        PropKind::Mesh => &["file", "scale"],
+    };
+    let given = [("radius", p.radius.is_some()), ("height", p.height.is_some()), ("size", p.size.is_some()), ("file", p.file.is_some()), ("scale", p.scale.is_some())];
+    match given.iter().find(|(key, set)| *set && !reads.contains(key)) {
+        None => Ok(()),
+        Some((key, _)) => {
+            let shape = format!("{:?}", p.shape).to_lowercase();
+            let its = if reads.is_empty() { "it has no size".to_string() } else { format!("it reads {}", reads.join(" and ")) };
+            Err(invalid(&format!("props[{i}].{key}"), format!("props[{i}].{key} has no meaning for a {shape} ({its}); remove it")))
+        }
+    }
+}
+
+fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
+    let (solver, duration) = (&c.solver, run.seconds);
     positive("solver.dt", solver.dt)?;
     if solver.dt > duration {
-        return Err(invalid("solver.dt", format!("solver.dt = {} s is longer than scene.duration = {duration} s; use a shorter step", solver.dt)));
+        return Err(invalid(
+            "solver.dt",
+            format!("solver.dt = {} s is longer than {} = {} s: the run would be one step past its end; use a shorter step", short(solver.dt), run.key, short(duration)),
+        ));
     }
     non_negative("solver.damping", solver.damping)?;
     // Drag stronger than a step's inertia a billion times over leaves nothing to simulate
     // and loses the Newton system's digits.
     let most = 1e9 / solver.dt;
     if solver.damping > most {
-        return Err(invalid("solver.damping", format!("solver.damping = {} 1/s stops any motion within a billionth of a step; use at most {most:?}", solver.damping)));
+        return Err(invalid("solver.damping", format!("solver.damping = {} 1/s stops any motion within a billionth of a step; use at most {}", short(solver.damping), short(most))));
     }
     let n = &solver.newton;
     if n.max_iterations == 0 {
@@ -145,21 +197,21 @@ fn check_solver(c: &SceneConfig) -> Result<(), Invalid> {
     if !(n.error_share.is_finite() && (0.0..1.0).contains(&n.error_share)) {
         return Err(invalid(
             "solver.newton.error_share",
-            format!("solver.newton.error_share = {:?} must lie in [0, 1): a share of the step's local error (0: off)", n.error_share),
+            format!("solver.newton.error_share = {} must lie in [0, 1): a share of the step's local error (0: off)", short(n.error_share)),
         ));
     }
     let fast = &solver.fast;
     positive("solver.fast.dt", fast.dt)?;
     positive("solver.fast.drop_dt", fast.drop_dt)?;
     if solver.path == super::levels::SolverPath::Fast {
-        positive_at_most("solver.fast.dt", fast.dt, duration, "scene.duration: the fast path's long step must fit in the run")?;
-        positive_at_most("solver.fast.drop_dt", fast.drop_dt, duration, "scene.duration: a dropped cloth's step must fit in the run")?;
+        positive_at_most("solver.fast.dt", fast.dt, duration, &format!("{}: the fast path's long step must fit in the run", run.key))?;
+        positive_at_most("solver.fast.drop_dt", fast.drop_dt, duration, &format!("{}: a dropped cloth's step must fit in the run", run.key))?;
     }
     positive("solver.fast.coarsest_edge_share", fast.coarsest_edge_share)?;
     if !(fast.error_share.is_finite() && (0.0..1.0).contains(&fast.error_share)) {
         return Err(invalid(
             "solver.fast.error_share",
-            format!("solver.fast.error_share = {:?} must lie in [0, 1): a share of the step's local error (0: off; default 0.1)", fast.error_share),
+            format!("solver.fast.error_share = {} must lie in [0, 1): a share of the step's local error (0: off; default 0.1)", short(fast.error_share)),
         ));
     }
     if let Some(a) = solver.adaptive.filter(|a| a.enabled) {
@@ -197,7 +249,7 @@ struct Extent {
 fn check_cloth(c: &SceneConfig) -> Result<Extent, Invalid> {
     let cloth = &c.cloth;
     if !(cloth.warp_angle_deg.is_finite() && cloth.warp_angle_deg.abs() <= 360.0) {
-        return Err(invalid("cloth.warp_angle_deg", format!("cloth.warp_angle_deg must be an angle between -360 and 360 degrees, got {}", cloth.warp_angle_deg)));
+        return Err(invalid("cloth.warp_angle_deg", format!("cloth.warp_angle_deg must be an angle between -360 and 360 degrees, got {}", short(cloth.warp_angle_deg))));
     }
     point("cloth.position", cloth.position)?;
     let size = |key: &str, v: f64| positive_at_most(key, v, MAX_REACH, "larger than the room contact resolves");
@@ -206,7 +258,7 @@ fn check_cloth(c: &SceneConfig) -> Result<Extent, Invalid> {
         let d = size("cloth.diameter", cloth.diameter)?;
         for (key, v) in [("cloth.length", cloth.length), ("cloth.width", cloth.width)] {
             if v != 0.0 {
-                return Err(invalid(key, format!("{key} has no meaning for a disc (cloth.diameter = {d} m); remove it, or set cloth.diameter = 0 for a rectangle")));
+                return Err(invalid(key, format!("{key} has no meaning for a disc (cloth.diameter = {} m); remove it, or set cloth.diameter = 0 for a rectangle", short(d))));
             }
         }
         return Ok(Extent { size: d, key: "cloth.diameter" });
@@ -235,8 +287,11 @@ fn check_mesh(c: &SceneConfig, extent: &Extent) -> Result<(), Invalid> {
         return Err(invalid(
             "mesh.edge_length",
             format!(
-                "mesh.edge_length = {h:?} m leaves fewer than 2 elements across the cloth's {:?} m ({}); use at most {most:?} m, or a larger cloth",
-                extent.size, extent.key
+                "mesh.edge_length = {} m leaves fewer than 2 elements across the cloth's {} m ({}); use at most {} m, or a larger cloth",
+                short(h),
+                short(extent.size),
+                extent.key,
+                short(most)
             ),
         ));
     }
@@ -257,7 +312,7 @@ fn check_mesh(c: &SceneConfig, extent: &Extent) -> Result<(), Invalid> {
             if planned(mid) > MAX_VERTICES { fails = mid } else { passes = mid }
         }
         let least = 1.001 * passes;
-        return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {h:?} m gives about {vertices} vertices, more than the limit of {MAX_VERTICES}; use at least {least:.3e} m")));
+        return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {} m gives about {} vertices, more than the limit of {MAX_VERTICES}; use at least {least:.3e} m", short(h), short(vertices as f64))));
     }
     Ok(())
 }
@@ -293,28 +348,28 @@ fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
         // mesh's edges past √2 before the run starts.
         let h = c.mesh.edge_length;
         if a > h {
-            return Err(invalid("test.perturbation", format!("test.perturbation = {a} m is larger than an element (mesh.edge_length = {h} m); use at most {h}")));
+            return Err(invalid("test.perturbation", format!("test.perturbation = {} m is larger than an element (mesh.edge_length = {} m); use at most {}", short(a), short(h), short(h))));
         }
     }
     match kind {
         SceneKind::Tensile => {
             let strain = need("test.max_strain", t.max_strain)?;
             if strain > 1.0 {
-                return Err(invalid("test.max_strain", format!("test.max_strain = {strain} pulls past 100 % strain, where fabrics have long broken; use at most 1")));
+                return Err(invalid("test.max_strain", format!("test.max_strain = {} pulls past 100 % strain, where fabrics have long broken; use at most 1", short(strain))));
             }
             need("test.speed", t.speed)?;
         }
         SceneKind::EulerBuckling => {
             let s = need("test.end_shortening", t.end_shortening)?;
             if s >= 0.9 {
-                return Err(invalid("test.end_shortening", format!("test.end_shortening = {s} leaves almost no strip; use a fraction below 0.9")));
+                return Err(invalid("test.end_shortening", format!("test.end_shortening = {} leaves almost no strip; use a fraction below 0.9", short(s))));
             }
             need("test.speed", t.speed)?;
         }
         SceneKind::ShearBuckling => {
             let a = need("test.shear_angle_deg", t.shear_angle_deg)?;
             if a >= 60.0 {
-                return Err(invalid("test.shear_angle_deg", format!("test.shear_angle_deg = {a} is beyond any fabric's locking angle; use less than 60")));
+                return Err(invalid("test.shear_angle_deg", format!("test.shear_angle_deg = {} is beyond any fabric's locking angle; use less than 60", short(a))));
             }
             need("test.speed", t.speed)?;
         }
@@ -323,7 +378,7 @@ fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
             // Rolled further the strip would pass through its own clamp.
             let most = std::f64::consts::TAU / length;
             if k > most {
-                return Err(invalid("test.curvature", format!("test.curvature = {k:?} 1/m rolls the {length} m strip past a full circle; use at most {most:?}")));
+                return Err(invalid("test.curvature", format!("test.curvature = {} 1/m rolls the {} m strip past a full circle; use at most {}", short(k), short(length), short(most))));
             }
         }
         SceneKind::Cantilever | SceneKind::Drape => {}
@@ -336,6 +391,7 @@ fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
     if let Some(v) = t.clamp_length {
         positive_at_most("test.clamp_length", v, length, "the strip's length, cloth.length")?;
     }
+    super::possible::check_motion_fits(c)?;
     if kind == SceneKind::Drape {
         check_support(c, extent)?;
     }
@@ -391,7 +447,7 @@ fn check_contact(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
     positive_at_most("contact.stiffness", k.stiffness, 1e6, "the default 100 times ten thousand, where the Newton system loses its digits")?;
     for (name, mu) in [("contact.friction_static", k.friction_static), ("contact.friction_kinetic", k.friction_kinetic)] {
         if mu > 10.0 {
-            return Err(invalid(name, format!("{name} = {mu} is beyond any pair of surfaces (rubber on rubber is about 1); use at most 10")));
+            return Err(invalid(name, format!("{name} = {} is beyond any pair of surfaces (rubber on rubber is about 1); use at most 10", short(mu))));
         }
     }
     Ok(())

@@ -21,12 +21,12 @@ pub enum CurveError {
     #[error("point {index} is not finite; every strain and stress must be a finite number")]
     NotFinite { index: usize },
     #[error(
-        "points must be sorted by strictly increasing strain: point {index} (strain {x}) \
-         does not come after {previous}; sort the points by their first value"
+        "points must be sorted by strictly increasing strain: point {index} (strain {x:?}) \
+         does not come after {previous:?}; sort the points by their first value"
     )]
     Unsorted { index: usize, x: f64, previous: f64 },
     #[error(
-        "segment {index} (from strain {x0} to {x1}) has slope {slope}, but every segment must \
+        "segment {index} (from strain {x0:?} to {x1:?}) has slope {slope:?}, but every segment must \
          rise (slope > 0) so the material stays stable; make each stress larger than the one before"
     )]
     NonIncreasing { index: usize, x0: f64, x1: f64, slope: f64 },

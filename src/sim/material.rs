@@ -77,12 +77,12 @@ impl FabricPoints {
 /// A fabric property that is out of range, named by its preset key.
 #[derive(Debug, Error, PartialEq)]
 pub enum FabricError {
-    #[error("fabric.{key} must be {expected}, got {value}")]
+    #[error("fabric.{key} must be {expected}, got {value:?}")]
     OutOfRange { key: &'static str, expected: &'static str, value: f64 },
     #[error("fabric.{key}: {source}")]
     Curve { key: &'static str, source: CurveError },
     #[error(
-        "fabric.poisson_warp = {nu} makes the in-plane energy non-convex with these tensile curves \
+        "fabric.poisson_warp = {nu:?} makes the in-plane energy non-convex with these tensile curves \
          (the material would have no stable state); use a value below {limit:.3} or stiffen the softest \
          segments of the curves"
     )]
@@ -95,7 +95,7 @@ pub enum FabricError {
     )]
     SteepCurve { key: &'static str, slope: f64, max: f64 },
     #[error(
-        "fabric.bending_bias = {bias} N·m is too small for bending_warp = {warp} and bending_weft = {weft}: \
+        "fabric.bending_bias = {bias:?} N·m is too small for bending_warp = {warp:?} and bending_weft = {weft:?}: \
          eq. 3 would need a negative twisting rigidity; use at least {min:.3e} N·m"
     )]
     BiasTooSmall { bias: f64, warp: f64, weft: f64, min: f64 },

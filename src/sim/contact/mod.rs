@@ -115,7 +115,7 @@ impl ContactSettings {
     }
 
     pub fn validate(&self) -> Result<(), String> {
-        let positive = |key: &str, v: f64| if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("contact.{key} must be positive, got {v}")) };
+        let positive = |key: &str, v: f64| if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("contact.{key} must be positive, got {v:?}")) };
         positive("thickness", self.thickness)?;
         if let Some(v) = self.self_thickness {
             positive("self_thickness", v)?;
@@ -124,12 +124,12 @@ impl ContactSettings {
         positive("slip_speed", self.slip_speed)?;
         for (key, v) in [("friction_static", self.friction_static), ("friction_kinetic", self.friction_kinetic)] {
             if !(v >= 0.0 && v.is_finite()) {
-                return Err(format!("contact.{key} must be zero or positive, got {v}"));
+                return Err(format!("contact.{key} must be zero or positive, got {v:?}"));
             }
         }
         if self.friction_kinetic > self.friction_static {
             return Err(format!(
-                "contact.friction_kinetic = {} exceeds contact.friction_static = {}: sliding friction is at most sticking friction",
+                "contact.friction_kinetic = {:?} exceeds contact.friction_static = {:?}: sliding friction is at most sticking friction",
                 self.friction_kinetic, self.friction_static
             ));
         }

@@ -82,7 +82,7 @@ impl Prop {
         let invalid = |message: String| PropError::Invalid { name: name.to_string(), message };
         let positive = |what: &str, value: f64| {
             if !(value.is_finite() && value > 0.0) {
-                Err(invalid(format!("{what} must be positive, got {value}")))
+                Err(invalid(format!("{what} must be positive, got {value:?}")))
             } else if !(MIN_SIZE..=MAX_REACH).contains(&value) {
                 Err(invalid(format!("{what} = {value:?} m is outside what contact resolves, {MIN_SIZE} to {MAX_REACH} m")))
             } else {
@@ -90,10 +90,10 @@ impl Prop {
             }
         };
         if !position.is_finite() || position.abs().max_element() > MAX_REACH {
-            return Err(invalid(format!("position {position} must be finite and within {MAX_REACH} m of the origin")));
+            return Err(invalid(format!("position {:?} must be finite and within {MAX_REACH} m of the origin", position.to_array())));
         }
         if !rotation.is_finite() || !rotation.is_normalized() {
-            return Err(invalid(format!("rotation {rotation} is not a finite rotation; give finite angles")));
+            return Err(invalid(format!("rotation {:?} is not a finite rotation; give finite angles", rotation.to_array())));
         }
         // parry3d's cylinder runs along its local y axis; ours along z.
         let mut local_frame = Quat::IDENTITY;
@@ -120,7 +120,7 @@ impl Prop {
                     return Err(invalid("the mesh has no triangles".into()));
                 }
                 if let Some((i, v)) = vertices.iter().enumerate().find(|(_, v)| !v.is_finite() || v.abs().max_element() > MAX_REACH) {
-                    return Err(invalid(format!("vertex {} at {v} must be finite and within {MAX_REACH} m of the origin", i + 1)));
+                    return Err(invalid(format!("vertex {} at {:?} must be finite and within {MAX_REACH} m of the origin", i + 1, v.to_array())));
                 }
                 if let Some(t) = triangles.iter().find(|t| t.iter().any(|&i| i as usize >= vertices.len())) {
                     return Err(invalid(format!("triangle {t:?} refers to a vertex past the {} given", vertices.len())));

@@ -10,10 +10,20 @@ use thiserror::Error;
 pub enum StepError {
     #[error(
         "the simulation diverged with {integrator} at dt = {dt:e} s (t = {time:.6} s): {reason}. \
-         The last good state is kept. Use a smaller solver.dt or an implicit integrator \
-         (solver.integrator = \"implicit-euler\")"
+         The last good state is kept. {}",
+        divergence_advice(*.integrator)
     )]
     Diverged { integrator: IntegratorKind, dt: f64, time: f64, reason: String },
+}
+
+/// What to change after a divergence: an implicit integrator only where the run is not on
+/// one already.
+fn divergence_advice(integrator: IntegratorKind) -> &'static str {
+    if integrator.is_explicit() {
+        "Use a smaller solver.dt or an implicit integrator (solver.integrator = \"implicit-euler\")"
+    } else {
+        "Use a smaller solver.dt, or more damping (solver.damping)"
+    }
 }
 
 /// What one step cost.

@@ -1,0 +1,273 @@
+//! Loading a scene: the scene file, its fabric file and the `--set` overrides merged, the
+//! sheets converted and everything checked, every refusal traced to the file, the `--set`
+//! or the flag that gave the value (`Sources`), in the terms the user wrote it in: a sheet's
+//! field rather than the fabric key it became, `--duration` rather than `scene.duration`.
+
+use super::preset::{FABRICS, FabricConfig, PresetError, SCENES, SceneConfig, apply_override, looks_like_path, parse_override, read_table};
+use crate::fabric::Import;
+use crate::io::number::short;
+use std::path::Path;
+
+/// What `rosette run` says beside `--set`: the run's duration (`--duration`) and step
+/// bound (`--max-steps`). The checks use them and name the flag; `--max-steps` is the
+/// scene's `scene.max_steps`, `--duration` the run's length (the scene's own duration still
+/// sets what depends on it, such as the arc's roll).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunFlags {
+    pub duration: Option<f64>,
+    pub max_steps: Option<u64>,
+}
+
+/// Where each value of a scene came from, so that an error names the file or the `--set`
+/// that gave the bad value.
+struct Sources {
+    scene_file: String,
+    /// The fabric file named by `fabric.preset`, and the keys the scene's own `[fabric]`
+    /// table gives (those are the scene file's).
+    fabric_file: Option<String>,
+    scene_fabric_keys: Vec<String>,
+    /// Each `--set` (as `--set KEY=VALUE`) or flag (`--max-steps N`) that set a key, with
+    /// the key.
+    overrides: Vec<(Vec<String>, String)>,
+    /// The flags that set scene keys: their key in messages is replaced by the flag.
+    flags: Vec<(&'static str, &'static str)>,
+    /// The fabric keys the sheets gave, with their sources.
+    import: Import,
+    /// The scene and fabric files' values before the overrides, to quote as an example.
+    original: toml::Table,
+}
+
+impl Sources {
+    /// The file or `--set` a bad value at `key` (dotted, array indices dropped) came from.
+    fn blame(&self, key: &[String]) -> String {
+        let overlaps = |path: &[String]| path.iter().zip(key).all(|(a, b)| a == b);
+        if let Some((_, text)) = self.overrides.iter().rev().find(|(path, _)| overlaps(path)) {
+            return text.clone();
+        }
+        match (&self.fabric_file, key) {
+            (Some(fabric_file), [section, field, ..]) if section == "fabric" && !self.scene_fabric_keys.contains(field) => fabric_file.clone(),
+            _ => self.scene_file.clone(),
+        }
+    }
+
+    /// The value the files give at `key`, as TOML, if they give one.
+    fn original(&self, key: &[String]) -> Option<String> {
+        let (last, parents) = key.split_last()?;
+        let mut table = &self.original;
+        for part in parents {
+            table = table.get(part)?.as_table()?;
+        }
+        table.get(last).map(|v| v.to_string())
+    }
+
+    fn invalid(&self, key: &[String], message: String) -> PresetError {
+        PresetError::Invalid { file: self.blame(key), message: self.in_flags(message) }
+    }
+
+    /// `message` with the keys a flag set named by the flag (`scene.max_steps = 3` becomes
+    /// `--max-steps 3`).
+    fn in_flags(&self, message: String) -> String {
+        self.flags.iter().fold(message, |m, (key, flag)| m.replace(&format!("{key} = "), &format!("{flag} ")).replace(key, flag))
+    }
+
+    /// A fabric check that failed on `key` (`fabric.poisson_warp`): in the sheet's terms
+    /// where sheet values lie behind it, blamed on the `--set` or file that gave them.
+    fn fabric_invalid(&self, key: &str, message: String) -> PresetError {
+        let field = key.trim_start_matches("fabric.");
+        match crate::fabric::explain::explain(&self.import, field, &message) {
+            Some((text, fields)) => PresetError::Invalid { file: self.blame_fields(&fields).unwrap_or_else(|| self.blame(&key_parts(key))), message: text },
+            None => self.invalid(&key_parts(key), message),
+        }
+    }
+
+    /// A sheet that failed to convert, blamed on the `--set` that changed a field it names
+    /// where one did.
+    fn sheet_invalid(&self, file: &str, error: &crate::fabric::SheetError) -> PresetError {
+        let message = error.to_string();
+        let named = crate::fabric::explain::field_names(&crate::fabric::explain::quoted_fields(&message));
+        PresetError::Invalid { file: self.blame_fields(&named).unwrap_or_else(|| file.to_string()), message }
+    }
+
+    /// Where sheet fields (`kes.LT_warp`) came from: the first `--set` among them, else the
+    /// first's file.
+    fn blame_fields(&self, fields: &[String]) -> Option<String> {
+        let blamed: Vec<String> = fields.iter().map(|f| self.blame(&key_parts(&format!("fabric.{f}")))).collect();
+        blamed.iter().find(|b| b.starts_with("--")).or(blamed.first()).cloned()
+    }
+}
+
+/// A dotted key split into its parts, array indices (`props[0]`) dropped.
+fn key_parts(key: &str) -> Vec<String> {
+    key.split('.').map(|part| part.split('[').next().unwrap_or("").to_string()).filter(|part| !part.is_empty()).collect()
+}
+
+/// serde's message for a value of the wrong type or length, in the words of a scene file,
+/// led by the key.
+fn type_error(key: &str, message: &str, example: Option<String>) -> String {
+    let words = |s: &str| {
+        s.replace("f64", "a number")
+            .replace("floating point", "the number")
+            .replace("u64", "a whole number")
+            .replace("usize", "a whole number")
+            .replace("integer", "the whole number")
+            .replace("string", "the text")
+            .replace("sequence", "an array")
+    };
+    let message = crate::io::number::shorten_in(message.trim());
+    let message = message.as_str();
+    // serde's "invalid type: X, expected Y" (and value, length) read as "must be Y, got X".
+    let reworded = ["invalid type: ", "invalid value: ", "invalid length "].iter().find_map(|lead| {
+        let (got, expected) = message.strip_prefix(lead)?.split_once(", expected ")?;
+        let got = if *lead == "invalid length " { format!("{got} values") } else { words(got) };
+        Some(format!("must be {}, got {got}", words(expected)))
+    });
+    let text = match (reworded, key.is_empty()) {
+        (Some(text), false) => format!("{key} {text}"),
+        (None, false) => format!("{key}: {message}"),
+        (Some(text), true) => text,
+        (None, true) => message.to_string(),
+    };
+    match example {
+        Some(example) if !key.is_empty() => format!("{text}; the file has {key} = {example}"),
+        _ => text,
+    }
+}
+
+/// Deserialises `table` as a `T`, an error naming the key that failed (by its path, which
+/// plain serde leaves out).
+fn deserialize_named<T: serde::de::DeserializeOwned>(table: toml::Table) -> Result<T, (Vec<String>, String, String)> {
+    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+        let path = e.path().to_string();
+        let key = if path == "." { String::new() } else { path };
+        (key_parts(&key), key, e.into_inner().message().to_string())
+    })
+}
+
+/// Loads a scene by bundled name or path, applies `overrides` (`KEY=VALUE`), merges its
+/// fabric and checks everything: a value out of range is refused here, with the file or
+/// the `--set` that gave it, its key and how to fix it.
+pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, String), PresetError> {
+    load_scene_with(spec, overrides, &RunFlags::default())
+}
+
+/// [`load_scene`] for a run with `flags` (`rosette run --duration`, `--max-steps`).
+pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Result<(SceneConfig, String), PresetError> {
+    let (mut table, file) = read_table("scene", spec, SCENES, None)?;
+    let base = if looks_like_path(spec) || Path::new(spec).exists() { Path::new(spec).parent().map(Path::to_path_buf) } else { None };
+    let scene_fabric_keys = table.get("fabric").and_then(|v| v.as_table()).map(|t| t.keys().cloned().collect()).unwrap_or_default();
+    let mut sources = Sources {
+        scene_file: file.clone(),
+        fabric_file: None,
+        scene_fabric_keys,
+        overrides: Vec::new(),
+        flags: Vec::new(),
+        import: Import::default(),
+        original: toml::Table::new(),
+    };
+    let mut fabric_table = None;
+    // The fabric file named in the scene file, for the original values.
+    if let Some(name) = table.get("fabric").and_then(|f| f.get("preset")).and_then(|v| v.as_str()) {
+        let (fabric, fabric_file) = read_table("fabric", name, FABRICS, base.as_deref())?;
+        fabric_table = Some((name.to_string(), fabric, fabric_file));
+    }
+    sources.original = merge_fabric(table.clone(), fabric_table.as_ref().map(|f| f.1.clone()));
+    for o in overrides {
+        let (path, value) = parse_override(o)?;
+        apply_override(&mut table, &path, value).map_err(|m| PresetError::BadOverride { text: o.clone(), message: m })?;
+        sources.overrides.push((path, format!("--set {o}")));
+    }
+    if let Some(n) = flags.max_steps {
+        let path = key_parts("scene.max_steps");
+        apply_override(&mut table, &path, toml::Value::Integer(i64::try_from(n).unwrap_or(i64::MAX))).expect("[scene] is a table");
+        sources.overrides.push((path, format!("--max-steps {n}")));
+        sources.flags.push(("scene.max_steps", "--max-steps"));
+    }
+    if flags.duration.is_some() {
+        sources.flags.push(("--duration = ", "--duration "));
+    }
+    let preset = table.get("fabric").and_then(|f| f.get("preset"));
+    if let Some(preset) = preset {
+        let name = preset.as_str().ok_or_else(|| sources.invalid(&key_parts("fabric.preset"), format!("fabric.preset must be a fabric name or file in quotes, got {preset}")))?;
+        if fabric_table.as_ref().is_none_or(|f| f.0 != name) {
+            let (fabric, fabric_file) =
+                read_table("fabric", name, FABRICS, base.as_deref()).map_err(|e| {
+                    let message = match e {
+                        PresetError::Read { source, .. } => source.to_string(),
+                        e => e.to_string(),
+                    };
+                    sources.invalid(&key_parts("fabric.preset"), message)
+                })?;
+            fabric_table = Some((name.to_string(), fabric, fabric_file));
+        }
+    } else {
+        fabric_table = None;
+    }
+    if let Some((_, t, fabric_file)) = &mut fabric_table {
+        // Sheet fields the scene or a `--set` changes are converted with the file's sheet.
+        if let Some(scene_fabric) = table.get_mut("fabric").and_then(|v| v.as_table_mut()) {
+            crate::fabric::merge_scene_sheets(t, scene_fabric);
+        }
+        sources.fabric_file = Some(fabric_file.clone());
+        sources.import = expand_sheets(t, fabric_file).map_err(|e| sources.sheet_invalid(fabric_file, &e))?;
+        // The fabric file's own fields are checked here so errors name that file.
+        deserialize_named::<FabricConfig>(t.clone()).map_err(|(_, key, message)| {
+            let key = if key.is_empty() { key } else { format!("fabric.{key}") };
+            PresetError::Invalid { file: fabric_file.clone(), message: type_error(&key, &message, None) }
+        })?;
+        sources.fabric_file = Some(fabric_file.clone());
+    }
+    let mut table = merge_fabric(table, fabric_table.map(|f| f.1));
+    // A scene without a fabric file may carry its own sheets.
+    if let Some(fabric) = table.get_mut("fabric").and_then(|v| v.as_table_mut()) {
+        let import = expand_sheets(fabric, &file).map_err(|e| sources.sheet_invalid(&file, &e))?;
+        if !import.derived.is_empty() {
+            sources.import = import;
+        }
+    }
+    let mut config: SceneConfig = deserialize_named(table).map_err(|(parts, key, message)| {
+        let example = sources.original(&parts);
+        sources.invalid(&parts, type_error(&key, &message, example))
+    })?;
+    config.base_dir = base;
+    super::validate::check_scene_for(&config, flags.duration).map_err(|e| match (e.key.as_str(), flags.duration) {
+        ("--duration", Some(d)) => PresetError::Invalid { file: format!("--duration {}", short(d)), message: sources.in_flags(e.message) },
+        (key, _) if key.starts_with("fabric.") => sources.fabric_invalid(key, e.message),
+        (key, _) => {
+            // Traced to a `--set` of any key the value was weighed against, if there is one.
+            let set = std::iter::once(key).chain(e.also.iter().map(String::as_str)).map(key_parts).find(|k| sources.blame(k).starts_with("--"));
+            sources.invalid(&set.unwrap_or_else(|| key_parts(key)), e.message)
+        }
+    })?;
+    Ok((config, file))
+}
+
+/// Turns a fabric table's measurement sheets (`[kes]`, `[fast]`, `[cantilever]`) into
+/// fabric keys (crate::fabric); the defaults it had to use are reported on stderr. Returns
+/// what the sheets gave, with their sources.
+fn expand_sheets(table: &mut toml::Table, file: &str) -> Result<Import, crate::fabric::SheetError> {
+    let sheets = crate::fabric::Sheets::take(table)?;
+    if sheets.is_empty() {
+        return Ok(Import::default());
+    }
+    let import = crate::fabric::derive(&sheets, table)?;
+    for w in crate::fabric::import::apply(table, &import) {
+        crate::errln!("warning: {file}: {w}");
+    }
+    Ok(import)
+}
+
+/// The scene's table with its `[fabric]` keys laid over the fabric file's.
+fn merge_fabric(mut table: toml::Table, fabric_file: Option<toml::Table>) -> toml::Table {
+    let scene_fabric = table.remove("fabric").and_then(|v| v.as_table().cloned()).unwrap_or_default();
+    let mut fabric = fabric_file.unwrap_or_default();
+    let preset = scene_fabric.get("preset").cloned();
+    for (k, v) in scene_fabric {
+        fabric.insert(k, v);
+    }
+    if let Some(p) = preset {
+        fabric.insert("preset".into(), p);
+    }
+    table.insert("fabric".into(), toml::Value::Table(fabric));
+    table
+}
+

@@ -1,0 +1,188 @@
+//! What a run can honour and what its measures can be: the one place where a request is
+//! checked against what the rig can do in the time given, and a measure against what is
+//! physically possible.
+//!
+//! Before the run: a test's extent (strain, end shortening, shear angle) must be reached
+//! within the scene's duration ([`check_motion_fits`]); props must start clear of the cloth
+//! ([`check_start`]); a screenshot's camera must leave the cloth some pixels
+//! ([`check_camera`]). After it ([`judge`]): a drape coefficient outside [0, 1] is not a
+//! drape coefficient and is reported as not measured; wrinkles no taller than the seeded
+//! perturbation are the seed, not wrinkles; a motion the run ended before finishing (a
+//! short `--duration`) is said in the metrics' notes.
+
+use super::preset::{SceneConfig, SceneKind, ShearKinematics};
+use super::validate::Invalid;
+use super::{Measures, Metrics, Scene};
+use crate::io::number::short;
+
+/// How long the rig's prescribed motion lasts, s, and the test key that sets its extent:
+/// the tensile pull to `test.max_strain`, the Euler approach to `test.end_shortening`, the
+/// shear to `test.shear_angle_deg`. None for rigs without one (the arc's roll takes half
+/// the run by construction) or where a key is missing (refused elsewhere).
+pub fn motion_time(config: &SceneConfig) -> Option<(&'static str, f64)> {
+    let (t, c) = (&config.test, &config.cloth);
+    let speed = t.speed?;
+    match config.scene.kind {
+        SceneKind::Tensile => Some(("test.max_strain", t.max_strain? * c.length / speed)),
+        SceneKind::EulerBuckling => Some(("test.end_shortening", t.end_shortening? * c.length / speed)),
+        SceneKind::ShearBuckling => {
+            let angle = t.shear_angle_deg?.to_radians();
+            let travel = match t.shear_kinematics.unwrap_or_default() {
+                // The grip slides along the warp by width·tan γ.
+                ShearKinematics::Simple => c.width * angle.tan(),
+                // The grip swings through γ on a link of the width.
+                ShearKinematics::Trellis => c.width * angle,
+            };
+            Some(("test.shear_angle_deg", travel / speed))
+        }
+        _ => None,
+    }
+}
+
+/// Refuses a test whose extent the scene's own duration cannot reach: `test.max_strain =
+/// 0.5` at 1 mm/s on a 10 cm strip needs 50 s, and a 6 s scene would end at 6 % with the
+/// strain asked for nowhere in its results.
+pub fn check_motion_fits(config: &SceneConfig) -> Result<(), Invalid> {
+    let Some((key, needed)) = motion_time(config) else { return Ok(()) };
+    let duration = config.scene.duration;
+    // The step loop ends within a millionth of a step of the duration.
+    if needed <= duration * (1.0 + 1e-9) {
+        return Ok(());
+    }
+    let value = match key {
+        "test.max_strain" => config.test.max_strain,
+        "test.end_shortening" => config.test.end_shortening,
+        _ => config.test.shear_angle_deg,
+    }
+    .unwrap_or(f64::NAN);
+    let speed = config.test.speed.unwrap_or(f64::NAN);
+    let also = ["test.speed", "scene.duration", "cloth.length", "cloth.width", "test.shear_kinematics"].map(String::from).to_vec();
+    Err(Invalid {
+        key: key.to_string(),
+        also,
+        message: format!(
+            "{key} = {} at test.speed = {} m/s takes {} s, longer than scene.duration = {} s: the run would end at {:.0} % of it. \
+             Set scene.duration to at least {}, or test.speed to at least {} m/s",
+            short(value),
+            short(speed),
+            short(needed),
+            short(duration),
+            100.0 * duration / needed,
+            short(needed),
+            short(speed * needed / duration)
+        ),
+    })
+}
+
+/// Refuses props that start through the cloth: a vertex inside a prop, or an edge that
+/// passes through one. Contact would push such a cloth out violently (or hold it threaded
+/// on the prop), a start no laboratory has.
+/// A cloth resting on a prop within its contact layer (the Cusick specimen on its
+/// pedestal) is not through it: only a vertex deeper than the layer, or an edge between
+/// two vertices outside the layer that passes through the prop, is.
+pub fn check_start(scene: &Scene) -> Result<(), String> {
+    let x = &scene.state.x;
+    let layer = scene.config.contact.thickness;
+    for (i, prop) in scene.props.iter().enumerate() {
+        let distance: Vec<f64> = x.iter().map(|&p| prop.surface_point(p).distance).collect();
+        let inside = distance.iter().position(|&d| d < -layer);
+        let through = || {
+            scene.model.edges.iter().find(|e| {
+                let [a, b] = e.map(|v| v as usize);
+                distance[a] > layer && distance[b] > layer && prop.segment_entry(x[a], x[b]).is_some()
+            })
+        };
+        let at = match (inside, through()) {
+            (Some(v), _) => x[v],
+            (None, Some(e)) => 0.5 * (x[e[0] as usize] + x[e[1] as usize]),
+            (None, None) => continue,
+        };
+        return Err(format!(
+            "props[{i}] ('{}') starts through the cloth (at [{}, {}, {}] m): move it clear of the cloth (props[{i}].position), \
+             or the cloth clear of it (cloth.position)",
+            prop.name,
+            short(at.x),
+            short(at.y),
+            short(at.z)
+        ));
+    }
+    Ok(())
+}
+
+/// The fewest pixels the cloth may span in a screenshot: fewer, and the picture shows
+/// nothing recognisable.
+pub const MIN_PICTURE_PIXELS: f64 = 8.0;
+
+/// Refuses a camera distance at which the cloth (its largest extent) would span fewer than
+/// [`MIN_PICTURE_PIXELS`] of a picture `height` pixels tall with the vertical field of view
+/// `fov_y` (radians).
+pub fn check_camera(config: &SceneConfig, distance: f64, height: u32, fov_y: f64) -> Result<(), String> {
+    let c = &config.cloth;
+    let size = c.diameter.max(c.length).max(c.width);
+    let pixels = size / (2.0 * distance * (0.5 * fov_y).tan()) * f64::from(height);
+    if pixels < MIN_PICTURE_PIXELS {
+        let farthest = size * f64::from(height) / (2.0 * (0.5 * fov_y).tan() * MIN_PICTURE_PIXELS);
+        return Err(format!(
+            "--camera distance {} m: the {} m cloth would span {:.1} of the picture's {height} pixels; use at most {} m, or leave the distance out to frame the scene",
+            short(distance),
+            short(size),
+            pixels,
+            short(farthest)
+        ));
+    }
+    Ok(())
+}
+
+/// A shear wrinkle counts only where the sheet stands out of its plane by more than this
+/// many times the seeded perturbation (`test.perturbation`, a random lift between 0 and
+/// the amplitude): below, the "wrinkles" are the seed's own noise.
+pub const WRINKLE_OVER_SEED: f64 = 2.0;
+
+/// Checks a run's measures against what is possible and says in `metrics.notes` what was
+/// not measured or not reached; `duration` is the time the run was asked to cover.
+pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
+    let config = &scene.config;
+    match &mut metrics.measures {
+        Measures::Drape(d) if !(0.0..=1.0).contains(&d.drape_coefficient) => {
+            metrics.notes.push(format!(
+                "drape_coefficient not measured: the shadow ({:.6} m²) against the specimen ({:.6} m²) and the support \
+                 ({:.6} m²) gives {:.6}, outside [0, 1]: the cloth has not draped (it ran {} s{})",
+                d.shadow_area,
+                d.specimen_area,
+                d.support_area,
+                d.drape_coefficient,
+                short(metrics.simulated_seconds),
+                if metrics.settled == Some(false) { ", not settled" } else { "" }
+            ));
+            d.drape_coefficient = f64::NAN;
+        }
+        Measures::Shear(s) => {
+            let seed = config.test.perturbation.unwrap_or(0.0);
+            if s.wrinkle_amplitude <= WRINKLE_OVER_SEED * seed && s.wrinkle_count > 0 {
+                metrics.notes.push(format!(
+                    "no wrinkles counted: the sheet stands {} m out of its plane, not above {WRINKLE_OVER_SEED} times the seeded \
+                     test.perturbation = {} m",
+                    short(s.wrinkle_amplitude),
+                    short(seed)
+                ));
+                s.wrinkle_count = 0;
+                s.wrinkle_wavelength = 0.0;
+                s.wrinkle_angle_deg = f64::NAN;
+            }
+        }
+        _ => {}
+    }
+    let end = scene.state.time;
+    // The time is a sum of steps: a run to a motion's end may fall short of it by round-off.
+    let unfinished = !scene.model.motions_finished(end * (1.0 + 1e-9) + 1e-12);
+    if unfinished && metrics.stable {
+        let target = motion_time(config).map_or_else(|| ("test.curvature".to_string(), 0.5 * config.scene.duration), |(k, t)| (k.to_string(), t));
+        metrics.notes.push(format!(
+            "{} not reached: the run covered {} s of the {} s its motion takes (asked for {} s)",
+            target.0,
+            short(end),
+            short(target.1),
+            short(duration)
+        ));
+    }
+}
