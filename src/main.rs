@@ -149,10 +149,11 @@ enum Command {
 
 #[derive(Subcommand)]
 enum FabricAction {
-    /// Convert a sheet (a TOML file with [kes], [fast] and/or [cantilever] sections, or a
-    /// bundled fabric's name) into a fabric file with every value's source.
+    /// Convert a sheet (a TOML file with [kes], [fast] and/or [cantilever] sections, an
+    /// ARCSim material .json, or a bundled fabric's name) into a fabric file with every
+    /// value's source.
     Import {
-        /// The sheet file, or a bundled fabric (see `rosette fabric list`).
+        /// The sheet file, an ARCSim material (.json), or a bundled fabric (see `rosette fabric list`).
         sheet: String,
         /// Write the fabric file here (default: standard output).
         #[arg(long, value_name = "FILE.toml")]
@@ -171,8 +172,20 @@ enum FabricAction {
         /// A bundled fabric's name or a fabric file with sheets.
         fabric: String,
     },
-    /// List the bundled fabrics and the sheets they come from.
+    /// List the bundled fabrics, the sheets they come from, and who measured them.
     List,
+    /// Write a fabric (bundled name, fabric file or ARCSim material) as an ARCSim material
+    /// file: density, stretching and bending samples (docs/fabric-sheets.md).
+    Export {
+        /// A bundled fabric's name, a fabric file or an ARCSim material (.json).
+        fabric: String,
+        /// Write ARCSim's material format (JSON), the one export format.
+        #[arg(long, required = true)]
+        arcsim: bool,
+        /// Write the material here (default: standard output).
+        #[arg(long, value_name = "FILE.json")]
+        out: Option<std::path::PathBuf>,
+    },
 }
 
 /// Rendering the final state offscreen (`rosette run ... --screenshot`).
@@ -294,9 +307,15 @@ fn fabric(action: FabricAction) -> ExitCode {
             for b in rosette::scene::preset::FABRICS {
                 match rosette::fabric::parse_fabric(b.text, b.name) {
                     Ok(f) => {
-                        let sheets: Vec<&str> = f.sheets.sections().map(|s| s.kind.section()).collect();
+                        let mut sheets: Vec<&str> = f.sheets.sections().map(|s| s.kind.section()).collect();
+                        sheets.extend(f.sheets.arcsim.as_ref().map(|_| "arcsim"));
                         let from = if sheets.is_empty() { "keys".to_string() } else { sheets.join("+") };
-                        println!("{:<18} {:<16} {}", b.name, from, f.config.description);
+                        let who = match f.sheets.measured_by() {
+                            Some(who) => format!("measured by {who}"),
+                            None if sheets.is_empty() => "representative values".into(),
+                            None => "typical of its class".into(),
+                        };
+                        println!("{:<24} {:<16} {:<52} {}", b.name, from, who, f.config.description);
                     }
                     Err(e) => println!("{:<20} error: {e}", b.name),
                 }
@@ -310,7 +329,7 @@ fn fabric(action: FabricAction) -> ExitCode {
             };
             if loaded.sheets.is_empty() {
                 return bad(&format!(
-                    "{sheet}: no [kes], [fast] or [cantilever] section to import; `rosette fabric template` prints a sheet to fill in"
+                    "{sheet}: no [kes], [fast], [cantilever] or [arcsim] section to import; `rosette fabric template` prints a sheet to fill in"
                 ));
             }
             for w in &loaded.warnings {
@@ -335,6 +354,7 @@ fn fabric(action: FabricAction) -> ExitCode {
                 }
             }
         }
+        FabricAction::Export { fabric, arcsim: _, out } => cli::export_arcsim(&fabric, out.as_deref()),
         FabricAction::Check { fabric } => {
             let loaded = match load_fabric(&fabric) {
                 Ok(f) => f,

@@ -2,6 +2,10 @@
 //! command line (the work is `rosette::card`'s; here are the checks before it, the progress
 //! bar and the exit codes).
 
+mod arcsim;
+
+pub use arcsim::export_arcsim;
+
 use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, bad_input, check_writable};
 use std::io::IsTerminal;
 use std::process::ExitCode;

@@ -57,6 +57,7 @@ pub const TEXT_FIELDS: &[(&str, &str)] = &[
     ("specimen", "what was tested: fibre, weave, finish"),
     ("note", "anything a reader of the sheet should know"),
     ("standard", "the test standard and options used (e.g. \"ASTM D1388-18 option A\")"),
+    ("measured_by", "who measured this specimen and where it was published; leave it out for values typical of a class"),
 ];
 
 /// Whether a field feeds the simulator or is kept on the sheet only.
@@ -188,6 +189,8 @@ pub struct Sheets {
     pub kes: Option<Section>,
     pub fast: Option<Section>,
     pub cantilever: Option<Section>,
+    /// An ARCSim material (`[arcsim]`): it gives every key itself, so it stands alone.
+    pub arcsim: Option<super::arcsim::ArcsimSection>,
 }
 
 /// Why a sheet cannot be read. Every message names the field and says how to fix it.
@@ -215,12 +218,21 @@ pub enum SheetError {
     Inconsistent { fields: String, message: String },
     #[error("{what} is missing: {fix}")]
     Missing { what: String, fix: String },
+    #[error("{0}")]
+    Arcsim(#[from] super::arcsim::ArcsimError),
 }
 
 impl Sheets {
     /// True if the file has no sheet section.
     pub fn is_empty(&self) -> bool {
-        self.kes.is_none() && self.fast.is_none() && self.cantilever.is_none()
+        self.kes.is_none() && self.fast.is_none() && self.cantilever.is_none() && self.arcsim.is_none()
+    }
+
+    /// Who measured the fabric, from the first section that says (`measured_by`); None for
+    /// sheets typical of a class and for fabrics without sheets.
+    pub fn measured_by(&self) -> Option<&str> {
+        let arcsim = self.arcsim.as_ref().and_then(|a| a.text.get("measured_by"));
+        arcsim.or_else(|| self.sections().find_map(|s| s.text.get("measured_by"))).map(String::as_str)
     }
 
     /// The sections present, in the order KES, FAST, cantilever.
@@ -240,6 +252,16 @@ impl Sheets {
                 SheetKind::Fast => sheets.fast = Some(section),
                 SheetKind::Cantilever => sheets.cantilever = Some(section),
             }
+        }
+        if let Some(value) = table.remove("arcsim") {
+            if let Some(other) = sheets.sections().next() {
+                return Err(SheetError::Inconsistent {
+                    fields: format!("[arcsim] and [{}]", other.kind.section()),
+                    message: "an ARCSim material gives every fabric key itself; keep it alone, or convert the other sheet in a file of its own".into(),
+                });
+            }
+            let text: Vec<&str> = TEXT_FIELDS.iter().map(|(n, _)| *n).filter(|n| *n != "standard").collect();
+            sheets.arcsim = Some(super::arcsim::ArcsimSection::read(&value, &text)?);
         }
         Ok(sheets)
     }
