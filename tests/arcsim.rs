@@ -421,3 +421,26 @@ fn bad_material_files_exit_2_naming_the_field() {
     let out = rosette_cli(&["fabric", "import", path.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("arcsim.bendng"), "{}", String::from_utf8_lossy(&out.stderr));
 }
+
+/// A fabric file's `[arcsim]` section names the material file or holds it inline, with
+/// ARCSim's configuration multipliers: `thicken` multiplies the mass, stretching and bending
+/// alike (conf.cpp), the others one each.
+#[test]
+fn a_fabric_file_names_its_material_or_holds_it_inline_with_the_multipliers() {
+    let by_file = parse_fabric(&format!("thickness = 5e-4\n[arcsim]\ndata = \"{}\"", file("royal-target")), "by-file").unwrap();
+    let inline = import(&material("royal-target"));
+    assert_eq!(by_file.config.properties.tensile_warp, inline.config.properties.tensile_warp);
+    assert_eq!(by_file.config.properties.bending_warp, inline.config.properties.bending_warp);
+    let scaled = parse_fabric(&format!("thickness = 5e-4\n[arcsim]\ndata = \"{}\"\nthicken = 2\nbending_mult = 1.5", file("royal-target")), "scaled").unwrap();
+    let (a, b) = (&inline.config.properties, &scaled.config.properties);
+    assert!(close(b.areal_density, 2.0 * a.areal_density, 1e-15));
+    assert!(close(b.bending_warp, 3.0 * a.bending_warp, 1e-15));
+    assert!(close(b.tensile_warp[1][1] / b.tensile_warp[1][0], 2.0 * a.tensile_warp[1][1] / a.tensile_warp[1][0], 1e-12));
+    assert!(close(b.shear_modulus, 2.0 * a.shear_modulus, 1e-15));
+    let err = parse_fabric("[arcsim]\ndata = \"no-such-material.json\"", "missing").unwrap_err().to_string();
+    assert!(err.contains("no-such-material.json"), "{err}");
+    let err = parse_fabric(&format!("[arcsim]\ndata = \"{}\"\nthicken = -1", file("royal-target")), "negative").unwrap_err().to_string();
+    assert!(err.contains("arcsim.thicken"), "{err}");
+    let err = parse_fabric(&format!("[kes]\nW = 13\n[arcsim]\ndata = \"{}\"", file("royal-target")), "both").unwrap_err().to_string();
+    assert!(err.contains("[arcsim] and [kes]"), "{err}");
+}
