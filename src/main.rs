@@ -323,13 +323,16 @@ fn fabric(action: FabricAction) -> ExitCode {
             ExitCode::SUCCESS
         }
         FabricAction::Import { sheet, out } => {
+            if let Some(path) = out.as_deref().filter(|p| cli::same_file(&sheet, p)) {
+                return bad(&format!("--out {}: is the file being imported; write the fabric to another file", path.display()));
+            }
             let loaded = match load_fabric(&sheet) {
                 Ok(f) => f,
                 Err(e) => return bad(&e),
             };
             if loaded.sheets.is_empty() {
                 return bad(&format!(
-                    "{sheet}: no [kes], [fast], [cantilever] or [arcsim] section to import; `rosette fabric template` prints a sheet to fill in"
+                    "{sheet}: no [kes], [fast] or [cantilever] section (nor an [arcsim] material) to import; `rosette fabric template` prints a sheet to fill in"
                 ));
             }
             for w in &loaded.warnings {

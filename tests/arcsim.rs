@@ -105,8 +105,9 @@ struct Ring<'a> {
 /// the boundary's few).
 fn hinge_energy_density(m: &ArcsimMaterial, ring: &Ring) -> f64 {
     type Corner = (usize, usize);
+    type Faces = Vec<(usize, Corner, Corner)>;
     let id = |(i, j): Corner| (i % ring.columns, j);
-    let mut faces_of: std::collections::HashMap<((usize, usize), (usize, usize)), Vec<(usize, Corner, Corner)>> = Default::default();
+    let mut faces_of: std::collections::HashMap<(Corner, Corner), Faces> = Default::default();
     for (t, tri) in ring.triangles.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
@@ -401,6 +402,11 @@ fn bad_material_files_exit_2_naming_the_field() {
         assert_eq!(out.status.code(), Some(2), "{name}: {stderr}");
         assert!(stderr.contains(field), "{name}: {stderr}");
     }
+    // The import's output never overwrites the material it reads.
+    let material_copy = temp("copy.json", &denim);
+    let out = rosette_cli(&["fabric", "import", material_copy.to_str().unwrap(), "--out", material_copy.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&material_copy).unwrap(), denim);
     // Only regular files of a material's size are read.
     let dir = temp("a-folder.json", "");
     std::fs::remove_file(&dir).unwrap();

@@ -5,7 +5,7 @@ use rosette::fabric::arcsim::export::{export, to_json};
 use std::process::ExitCode;
 
 /// Whether `out` is the file `spec` was read from (an output must not overwrite an input).
-fn same_file(spec: &str, out: &std::path::Path) -> bool {
+pub fn same_file(spec: &str, out: &std::path::Path) -> bool {
     match (std::fs::canonicalize(spec), std::fs::canonicalize(out)) {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
@@ -40,10 +40,8 @@ pub fn export_arcsim(spec: &str, out: Option<&std::path::Path>) -> ExitCode {
         "rows for hinges along u, at 45 degrees and along v, at 0-40 1/m; a strip's rigidity is a quarter of its sample.".into(),
         "What each value is and what Rosette's fabric keys leave out: Rosette's docs/fabric-sheets.md, ARCSim materials.".into(),
     ];
-    if let Some(a) = &loaded.sheets.arcsim {
-        if let Some(source) = a.text.get("source") {
-            comments.push(format!("Imported from: {source}"));
-        }
+    if let Some(source) = loaded.sheets.arcsim.as_ref().and_then(|a| a.text.get("source")) {
+        comments.push(format!("Imported from: {source}"));
     }
     if let Some(who) = loaded.sheets.measured_by() {
         comments.push(format!("Measured by {who}; cite their publication with the data."));

@@ -4,7 +4,7 @@
 
 mod arcsim;
 
-pub use arcsim::export_arcsim;
+pub use arcsim::{export_arcsim, same_file};
 
 use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, bad_input, check_writable};
 use std::io::IsTerminal;

@@ -129,10 +129,14 @@ fn tensile(m: &ArcsimMaterial, angle: f64, name: &str, modulus: f64, warnings: &
     points
 }
 
+/// Curvatures (1/m) over which a curve departs from ARCSim's: where ARCSim's moment starts
+/// to fall, and where it climbs back.
+pub type HeldRange = (f64, f64);
+
 /// The warp's moment–curvature curve, rising, and the curvatures over which it departs
 /// from ARCSim's [start of the fall, where ARCSim's moment climbs back], if it does; None
 /// when the warp's samples do not vary with the curvature.
-pub fn warp_bending_curve(m: &ArcsimMaterial) -> Option<(Vec<[f64; 2]>, Option<(f64, f64)>)> {
+pub fn warp_bending_curve(m: &ArcsimMaterial) -> Option<(Vec<[f64; 2]>, Option<HeldRange>)> {
     let row = &m.bending[WARP_ROW];
     if row.iter().all(|&v| (v - row[0]).abs() <= 1e-9 * row[0]) {
         return None;
@@ -227,7 +231,7 @@ pub fn derive(m: &ArcsimMaterial, origin: &str, explicit: &toml::Table) -> Impor
     for (i, (key, row)) in rows.into_iter().enumerate() {
         rigidity[i] = HINGE_FACTOR * m.bending[row][0];
         let across = ["hinges along v, across a warp bend", "hinges along u, across a weft bend", "hinges at 45°"][i];
-        push(key, float(rigidity[i]), format!("{origin}: bending[{row}][0] = {} N·m × ¼ ({across})", m.bending[row][0]), false);
+        push(key, float(rigidity[i]), format!("{origin}: bending[{row}][0] = {:e} N·m × ¼ ({across})", m.bending[row][0]), false);
     }
     // Eq. 3's middle term must stay positive: B₄₅ > (B_x + B_y)/4.
     let least = 0.25 * (rigidity[0] + rigidity[1]) * 1.001;
@@ -252,8 +256,8 @@ pub fn derive(m: &ArcsimMaterial, origin: &str, explicit: &toml::Table) -> Impor
             key: "bending_curve",
             value: curve_value(&curve),
             source: format!(
-                "{origin}: bending[{WARP_ROW}] ({:?} N·m at 0–40 m⁻¹): M = κ·ke(κ)/4, ke linear between samples every {CURVATURE_STEP} m⁻¹, held beyond",
-                m.bending[WARP_ROW]
+                "{origin}: bending[{WARP_ROW}] ({} N·m at 0–40 m⁻¹): M = κ·ke(κ)/4, ke linear between samples every {CURVATURE_STEP} m⁻¹, held beyond",
+                m.bending[WARP_ROW].iter().map(|v| format!("{v:e}")).collect::<Vec<_>>().join(", ")
             ),
             default: false,
             section: None,
