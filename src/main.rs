@@ -171,10 +171,11 @@ enum Command {
 
 #[derive(Subcommand)]
 enum FabricAction {
-    /// Convert a sheet (a TOML file with [kes], [fast] and/or [cantilever] sections, or a
-    /// bundled fabric's name) into a fabric file with every value's source.
+    /// Convert a sheet (a TOML file with [kes], [fast] and/or [cantilever] sections, an
+    /// ARCSim material .json, or a bundled fabric's name) into a fabric file with every
+    /// value's source.
     Import {
-        /// The sheet file, or a bundled fabric (see `rosette fabric list`).
+        /// The sheet file, an ARCSim material (.json), or a bundled fabric (see `rosette fabric list`).
         sheet: String,
         /// Write the fabric file here (default: standard output).
         #[arg(long, value_name = "FILE.toml")]
@@ -197,8 +198,24 @@ enum FabricAction {
         /// A bundled fabric's name or a fabric file with sheets.
         fabric: String,
     },
-    /// List the bundled fabrics and the sheets they come from.
+    /// List the bundled fabrics, the sheets they come from, and who measured them.
     List,
+    /// Write a fabric (bundled name, fabric file or ARCSim material) as an ARCSim material
+    /// file: density, stretching and bending samples (docs/fabric-sheets.md).
+    Export {
+        /// A bundled fabric's name, a fabric file or an ARCSim material (.json).
+        fabric: String,
+        /// Write ARCSim's material format (JSON), the one export format.
+        #[arg(long, required = true)]
+        arcsim: bool,
+        /// Write the material here (default: standard output).
+        #[arg(long, value_name = "FILE.json")]
+        out: Option<std::path::PathBuf>,
+        /// Replace an existing file that is not a material Rosette wrote (an input of the
+        /// command is never overwritten).
+        #[arg(long)]
+        force: bool,
+    },
 }
 
 /// Rendering the final state offscreen (`rosette run ... --screenshot`).
@@ -282,6 +299,7 @@ fn dispatch(cli: Cli) -> ExitCode {
             FabricAction::List => cli::fabric::list(),
             FabricAction::Import { sheet, out, force } => cli::fabric::import(&sheet, out.as_deref(), force),
             FabricAction::Check { fabric } => cli::fabric::check(&fabric),
+            FabricAction::Export { fabric, arcsim: _, out, force } => cli::arcsim::export(&fabric, out.as_deref(), force),
         },
         Some(Command::Run { preset, mut overrides, duration, metrics, outline, step_log, max_steps, max_wall, fast, export, export_frames, force, screenshot }) => {
             if fast {

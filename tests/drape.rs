@@ -153,3 +153,44 @@ fn random_starts_scatter_the_coefficient_by_a_few_hundredths() {
     assert!(spread < 0.05, "seeds scatter DC by {spread:.3}");
     assert!(dcs.windows(2).any(|w| w[0] != w[1]), "the seed changed nothing: the perturbation is not used");
 }
+
+/// The four wovens Wang, O'Brien and Ramamoorthi measured (ARCSim materials, issue 38) on
+/// the standard's 30 cm specimen: they settle with every Newton solve converged, into 4–10
+/// folds, out of the pedestal and themselves, between the independent-strip bound and a
+/// flat disc. No drape coefficient of theirs was measured, so none is held to a class; nor
+/// are they held to the bending-length order, which assumes linear bending: their moment
+/// curves stiffen (the royal-target's warp by 72 % at 20 m⁻¹) or soften and recover (the
+/// white-dots polyester's to 73 % at 10 m⁻¹). Their coefficients are in docs/fabrics/README.md.
+#[test]
+fn the_measured_arcsim_wovens_settle_into_clean_folds_above_the_strip_bound() {
+    const WOVENS: [&str; 4] = ["11oz-black-denim", "royal-target", "white-dots-on-blk", "pink-ribbon-brown"];
+    let results = run_all("cusick-drape-30", WOVENS.iter().map(|f| vec![format!("fabric.preset={f}")]).collect());
+    for (fabric, (config, m)) in WOVENS.iter().zip(&results) {
+        let dc = drape_coefficient(m);
+        let nodes = m.measures.drape().expect("drape measures").nodes;
+        // The strip bound with the lowest secant rigidity the fabric's moment curve reaches:
+        // a softening curve makes the sheet more flexible than its first rigidity says.
+        let softest = config.fabric.properties.bending_curve.as_ref().map_or(1.0, |c| {
+            let slope = c[1][1] / c[1][0];
+            c.iter().filter(|p| p[0] > 0.0).map(|p| p[1] / (p[0] * slope)).fold(1.0, f64::min)
+        });
+        let bound = strip_bound_scaled(config, softest);
+        println!("{fabric}: DC {dc:.3}, {nodes} nodes, bending length {:.1} mm, strip bound {bound:.3}", 1e3 * bending_length(config));
+        assert_eq!(m.settled, Some(true), "{fabric} never settled");
+        assert!(m.converged && m.newton_limit_steps == 0, "{fabric}: {} steps at the Newton limit", m.newton_limit_steps);
+        assert!(dc > bound && dc < 1.0, "{fabric}: DC {dc:.3} outside ({bound:.3}, 1)");
+        assert!((4..=10).contains(&nodes), "{fabric}: {nodes} nodes");
+        assert_eq!(m.self_intersections, Some(0), "{fabric}");
+        assert!(m.max_penetration.unwrap() < config.contact.thickness, "{fabric}: {:?}", m.max_penetration);
+    }
+}
+
+/// [`strip_bound`] with every rigidity scaled by `scale`.
+fn strip_bound_scaled(config: &SceneConfig, scale: f64) -> f64 {
+    let mut scaled = config.clone();
+    let f = &mut scaled.fabric.properties;
+    f.bending_warp *= scale;
+    f.bending_weft *= scale;
+    f.bending_bias = f.bending_bias.map(|b| b * scale);
+    strip_bound(&scaled)
+}

@@ -46,13 +46,14 @@ fn assert_read_back(name: &str, r: &ReadBack) {
     }
 }
 
-/// Every bundled fabric that comes from a sheet (KES, FAST, cantilever) reads it back.
+/// Every bundled fabric that comes from a sheet (KES, FAST, cantilever) reads it back
+/// (the ARCSim materials have their own round trip, tests/arcsim_lab.rs).
 #[test]
 fn bundled_sheets_read_back_within_the_issue_tolerances() {
     let sheet_fabrics: Vec<(&str, LoadedFabric)> = FABRICS
         .iter()
         .map(|b| (b.name, load_fabric(b.name).unwrap()))
-        .filter(|(_, f)| !f.sheets.is_empty())
+        .filter(|(_, f)| !f.sheets.is_empty() && f.sheets.arcsim.is_none())
         .collect();
     assert!(sheet_fabrics.len() >= 7, "the library's sheet fabrics: {}", sheet_fabrics.len());
     let results = on_two_cores(&sheet_fabrics, |(name, fabric)| check(name, fabric));

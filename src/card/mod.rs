@@ -294,6 +294,14 @@ pub struct SheetValue {
     pub tolerance_percent: f64,
     pub test: String,
     pub passes: bool,
+    /// False for a value the fabric's keys cannot hold (an ARCSim sample its projection
+    /// drops): reported, not held to the tolerance.
+    #[serde(default = "held_by_default")]
+    pub held: bool,
+}
+
+fn held_by_default() -> bool {
+    true
 }
 
 /// What the card cost to make.

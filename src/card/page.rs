@@ -228,7 +228,11 @@ fn tables(area: &Area, card: &Card) -> DrawResult {
     // As many rows as the space holds, the rest in the JSON.
     let shown = if card.sheet_readback.len() > 8 { 7 } else { card.sheet_readback.len() };
     for v in &card.sheet_readback[..shown] {
-        let style = if v.passes { small.clone() } else { font(13).color(&BAD) };
+        let style = match (v.held, v.passes) {
+            (false, _) => grey.clone(),
+            (true, true) => small.clone(),
+            (true, false) => font(13).color(&BAD),
+        };
         let field = format!("{} {}", v.field.replace(" → 123/EB5", ""), v.unit);
         let cells = [(0, field), (150, format!("{:.4}", v.sheet)), (205, format!("{:.4}", v.measured)), (265, format!("{:+.2} %", v.error_percent))];
         t.row(&cells, &style)?;
@@ -237,9 +241,14 @@ fn tables(area: &Area, card: &Card) -> DrawResult {
         t.row(&[(0, format!("… {} more in the JSON", card.sheet_readback.len() - shown))], &grey)?;
     }
     let outside = card.sheet_readback.iter().filter(|v| !v.passes).count();
+    let held = card.sheet_readback.iter().filter(|v| v.held).count();
+    let reported = match card.sheet_readback.len() - held {
+        0 => String::new(),
+        n => format!("; {n} grey: dropped by the import, reported"),
+    };
     let verdict = match outside {
-        0 => (format!("all {} within tolerance", card.sheet_readback.len()), grey),
-        n => (format!("{n} of {} outside tolerance", card.sheet_readback.len()), font(13).color(&BAD)),
+        0 => (format!("all {held} within tolerance{reported}"), grey),
+        n => (format!("{n} of {held} outside tolerance{reported}"), font(13).color(&BAD)),
     };
     t.row(&[(0, verdict.0)], &verdict.1)?;
     Ok(())

@@ -268,6 +268,7 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
                 tolerance_percent: 100.0 * q.tolerance,
                 test: q.test.into(),
                 passes: q.passes(),
+                held: q.held(),
             })
             .collect(),
         _ => Vec::new(),

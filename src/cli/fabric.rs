@@ -25,9 +25,15 @@ pub fn list() -> ExitCode {
     for b in rosette::scene::preset::FABRICS {
         match rosette::fabric::parse_fabric(b.text, b.name) {
             Ok(f) => {
-                let sheets: Vec<&str> = f.sheets.sections().map(|s| s.kind.section()).collect();
+                let mut sheets: Vec<&str> = f.sheets.sections().map(|s| s.kind.section()).collect();
+                sheets.extend(f.sheets.arcsim.as_ref().map(|_| "arcsim"));
                 let from = if sheets.is_empty() { "keys".to_string() } else { sheets.join("+") };
-                outln!("{:<18} {:<16} {}", b.name, from, f.config.description);
+                let who = match f.sheets.measured_by() {
+                    Some(who) => format!("measured by {who}"),
+                    None if sheets.is_empty() => "representative values".into(),
+                    None => "typical of its class".into(),
+                };
+                outln!("{:<24} {:<16} {:<52} {}", b.name, from, who, f.config.description);
             }
             Err(e) => outln!("{:<20} error: {e}", b.name),
         }
@@ -42,7 +48,7 @@ pub fn import(sheet: &str, out: Option<&Path>, force: bool) -> ExitCode {
     };
     if loaded.sheets.is_empty() {
         return bad_input(format!(
-            "{sheet}: no [kes], [fast] or [cantilever] section to import; `rosette fabric template` prints a sheet to fill in"
+            "{sheet}: no [kes], [fast] or [cantilever] section (nor an [arcsim] material) to import; `rosette fabric template` prints a sheet to fill in"
         ));
     }
     if let Some(path) = out {

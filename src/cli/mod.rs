@@ -2,6 +2,7 @@
 //! before any work (inputs, outputs, what the run can honour), the progress bars, the
 //! outputs and the exit codes.
 
+pub mod arcsim;
 pub mod card;
 pub mod fabric;
 pub mod outputs;

@@ -182,10 +182,10 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
     }
     // Put in place once the run's metrics are saved: a log that fails mid-run (a full
     // disk) does not cost the run's results.
-    if let (Some(log), Some(path)) = (step_log, outputs.step_log) {
-        if let Some(e) = log_error.map(Err).unwrap_or_else(|| log.finish()).err() {
-            fail(format!("--step-log {}: cannot write the step log: {e}", path.display()));
-        }
+    if let (Some(log), Some(path)) = (step_log, outputs.step_log)
+        && let Some(e) = log_error.map(Err).unwrap_or_else(|| log.finish()).err()
+    {
+        fail(format!("--step-log {}: cannot write the step log: {e}", path.display()));
     }
     for note in &metrics.notes {
         errln!("note: {name}: {note}");

@@ -500,6 +500,9 @@ impl Deriver<'_> {
 /// The fabric keys the sheets give. `explicit` holds the keys written directly in the
 /// fabric file: they win, and they feed the conversions that need them (the bias).
 pub fn derive(sheets: &Sheets, explicit: &toml::Table) -> Result<Import, SheetError> {
+    if let Some(arcsim) = &sheets.arcsim {
+        return Ok(super::arcsim::project::derive(&arcsim.material(), &arcsim.origin(), explicit));
+    }
     let mut d = Deriver { sheets, explicit, out: Import::default() };
     let rho = d.areal_density()?;
     d.thickness(rho);
@@ -521,7 +524,7 @@ pub fn derive(sheets: &Sheets, explicit: &toml::Table) -> Result<Import, SheetEr
     Ok(d.out)
 }
 
-/// Replaces the sheet sections (`[kes]`, `[fast]`, `[cantilever]`) of a fabric table by
+/// Replaces the sheet sections (`[kes]`, `[fast]`, `[cantilever]`, `[arcsim]`) of a fabric table by
 /// the fabric keys they give. A key already in the table wins; a warning says so where the
 /// sheet disagrees with it. Returns the warnings (defaults used, disagreements).
 pub fn expand_sheets(table: &mut toml::Table) -> Result<Vec<String>, SheetError> {

@@ -2,12 +2,14 @@
 //! results turned into the simulator's fabric keys, each with its source.
 //!
 //! A fabric file may hold `[kes]`, `[fast]` and `[cantilever]` sections instead of (or
-//! beside) the fabric keys; [`expand_sheets`] converts them when the file is loaded. The
+//! beside) the fabric keys, or an ARCSim material in `[arcsim]` ([`arcsim`]);
+//! [`expand_sheets`] converts them when the file is loaded. The
 //! conversions use the exact unit factors of [`units`]; the tensile curves are built as
 //! [`tensile`] describes; a measured bias bending length goes through the strip theory of
 //! [`bias`]. `rosette fabric import` writes the converted file with every value's source
 //! ([`write`]); docs/fabric-sheets.md is the user's guide to all of it.
 
+pub mod arcsim;
 pub mod bias;
 pub mod explain;
 pub mod import;
@@ -51,11 +53,16 @@ pub enum LoadError {
 
 /// Reads a fabric file's text: sheets converted, keys checked.
 pub fn parse_fabric(text: &str, file: &str) -> Result<LoadedFabric, LoadError> {
-    let sheet_error = |source| LoadError::Sheet { file: file.into(), source: Box::new(source) };
     // A file's contents are quoted only where it is named as a fabric file (FILE.toml).
-    let mut table = crate::io::read::parse_toml(text, Some(std::path::Path::new(file)), crate::io::read::FileKind::Fabric)
+    let table = crate::io::read::parse_toml(text, Some(std::path::Path::new(file)), crate::io::read::FileKind::Fabric)
         .map_err(|message| LoadError::Syntax { file: file.into(), message })?;
     crate::scene::preset::refuse_fabric_preset(&table).map_err(|message| LoadError::Invalid { file: file.into(), message })?;
+    from_table(table, file)
+}
+
+/// A fabric file's table read: sheets converted, keys checked.
+fn from_table(mut table: toml::Table, file: &str) -> Result<LoadedFabric, LoadError> {
+    let sheet_error = |source| LoadError::Sheet { file: file.into(), source: Box::new(source) };
     let sheets = Sheets::take(&mut table).map_err(sheet_error)?;
     let import = if sheets.is_empty() { Import::default() } else { derive(&sheets, &table).map_err(sheet_error)? };
     let warnings = import::apply(&mut table, &import);
@@ -68,8 +75,30 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<LoadedFabric, LoadError> {
     Ok(LoadedFabric { file: file.into(), config, sheets, import, warnings })
 }
 
-/// Loads a bundled fabric by name (`wool`) or a fabric file by path.
+/// Whether `spec` names an ARCSim material file (`….json`) rather than a fabric file.
+pub fn is_arcsim_file(spec: &str) -> bool {
+    std::path::Path::new(spec).extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
+}
+
+/// An ARCSim material file read as a fabric: the file is the fabric's `[arcsim]` section
+/// (`data = "FILE"`), named after the file.
+fn load_arcsim(spec: &str) -> Result<LoadedFabric, LoadError> {
+    let stem = std::path::Path::new(spec).file_stem().map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into_owned());
+    let mut table = toml::Table::new();
+    table.insert("name".into(), toml::Value::String(format!("{stem} (ARCSim material)")));
+    table.insert("description".into(), toml::Value::String(format!("ARCSim material {spec}, imported by Rosette's projection")));
+    let mut section = toml::Table::new();
+    section.insert("data".into(), toml::Value::String(spec.into()));
+    table.insert("arcsim".into(), toml::Value::Table(section));
+    from_table(table, spec)
+}
+
+/// Loads a bundled fabric by name (`wool`), a fabric file by path, or an ARCSim material
+/// file (`….json`).
 pub fn load_fabric(spec: &str) -> Result<LoadedFabric, LoadError> {
+    if is_arcsim_file(spec) {
+        return load_arcsim(spec);
+    }
     let is_path = spec.contains('/') || spec.contains('\\') || spec.ends_with(".toml");
     if !is_path && let Some(b) = FABRICS.iter().find(|b| b.name == spec) {
         return parse_fabric(b.text, &format!("presets/fabrics/{}.toml (bundled)", b.name));

@@ -57,6 +57,7 @@ pub const TEXT_FIELDS: &[(&str, &str)] = &[
     ("specimen", "what was tested: fibre, weave, finish"),
     ("note", "anything a reader of the sheet should know"),
     ("standard", "the test standard and options used (e.g. \"ASTM D1388-18 option A\")"),
+    ("measured_by", "who measured this specimen and where it was published; leave it out for values typical of a class"),
 ];
 
 /// Whether a field feeds the simulator or is kept on the sheet only.
@@ -188,6 +189,26 @@ pub struct Sheets {
     pub kes: Option<Section>,
     pub fast: Option<Section>,
     pub cantilever: Option<Section>,
+    /// An ARCSim material (`[arcsim]`): it gives every key itself, so it stands alone.
+    pub arcsim: Option<super::arcsim::ArcsimSection>,
+}
+
+/// A sheet value written in a unit its field does not take (`SheetError::UnknownUnit`,
+/// boxed: the details are six fields, and every sheet function returns the error).
+#[derive(Debug, Error, PartialEq)]
+#[error(
+    "{section}.{field} = {written}: unknown unit '{unit}'{hint}; write a bare number in {default_unit} \
+     or a string with one of: {accepted}"
+)]
+pub struct UnknownUnit {
+    pub section: &'static str,
+    pub field: String,
+    pub written: String,
+    pub unit: String,
+    /// Where the unit is one of the field's own in another case: that it is refused, and why.
+    pub hint: String,
+    pub default_unit: &'static str,
+    pub accepted: &'static str,
 }
 
 /// Why a sheet cannot be read. Every message names the field and says how to fix it.
@@ -200,20 +221,8 @@ pub enum SheetError {
          (`rosette fabric template` prints them with their units)"
     )]
     UnknownField { section: &'static str, title: &'static str, field: String, known: String },
-    #[error(
-        "{section}.{field} = {written}: unknown unit '{unit}'{hint}; write a bare number in {default_unit} \
-         or a string with one of: {accepted}"
-    )]
-    UnknownUnit {
-        section: &'static str,
-        field: String,
-        written: String,
-        unit: String,
-        /// Where the unit is one of the field's own in another case: that it is refused, and why.
-        hint: String,
-        default_unit: &'static str,
-        accepted: &'static str,
-    },
+    #[error("{0}")]
+    UnknownUnit(Box<UnknownUnit>),
     #[error("{section}.{field} = {written}: expected a number in {default_unit} or a string \"VALUE UNIT\" such as \"{example}\"")]
     NotAValue { section: &'static str, field: String, written: String, default_unit: &'static str, example: String },
     #[error("{section}.{field} = {written}: must be {expected}")]
@@ -224,12 +233,21 @@ pub enum SheetError {
     Inconsistent { fields: String, message: String },
     #[error("{what} is missing: {fix}")]
     Missing { what: String, fix: String },
+    #[error("{0}")]
+    Arcsim(#[from] super::arcsim::ArcsimError),
 }
 
 impl Sheets {
     /// True if the file has no sheet section.
     pub fn is_empty(&self) -> bool {
-        self.kes.is_none() && self.fast.is_none() && self.cantilever.is_none()
+        self.kes.is_none() && self.fast.is_none() && self.cantilever.is_none() && self.arcsim.is_none()
+    }
+
+    /// Who measured the fabric, from the first section that says (`measured_by`); None for
+    /// sheets typical of a class and for fabrics without sheets.
+    pub fn measured_by(&self) -> Option<&str> {
+        let arcsim = self.arcsim.as_ref().and_then(|a| a.text.get("measured_by"));
+        arcsim.or_else(|| self.sections().find_map(|s| s.text.get("measured_by"))).map(String::as_str)
     }
 
     /// The sections present, in the order KES, FAST, cantilever.
@@ -249,6 +267,16 @@ impl Sheets {
                 SheetKind::Fast => sheets.fast = Some(section),
                 SheetKind::Cantilever => sheets.cantilever = Some(section),
             }
+        }
+        if let Some(value) = table.remove("arcsim") {
+            if let Some(other) = sheets.sections().next() {
+                return Err(SheetError::Inconsistent {
+                    fields: format!("[arcsim] and [{}]", other.kind.section()),
+                    message: "an ARCSim material gives every fabric key itself; keep it alone, or convert the other sheet in a file of its own".into(),
+                });
+            }
+            let text: Vec<&str> = TEXT_FIELDS.iter().map(|(n, _)| *n).filter(|n| *n != "standard").collect();
+            sheets.arcsim = Some(super::arcsim::ArcsimSection::read(&value, &text)?);
         }
         Ok(sheets)
     }
@@ -351,7 +379,7 @@ fn read_value(section: &'static str, name: &str, field: &Field, value: &toml::Va
     };
     let scale = match unit.filter(|u| !u.is_empty()) {
         None => factor(field.quantity, field.unit).expect("every field's own unit is in its quantity's table"),
-        Some(u) => factor(field.quantity, u).ok_or_else(|| SheetError::UnknownUnit {
+        Some(u) => factor(field.quantity, u).ok_or_else(|| SheetError::UnknownUnit(Box::new(UnknownUnit {
             section,
             field: name.to_string(),
             written: written.clone(),
@@ -361,7 +389,7 @@ fn read_value(section: &'static str, name: &str, field: &Field, value: &toml::Va
             }),
             default_unit: unit_or_none(field.unit),
             accepted: field.quantity.spelled(),
-        })?,
+        })))?,
     };
     let si = number * scale;
     let positive_needed = field.use_ == Use::Model;

@@ -54,6 +54,10 @@ pub fn fabric_file(table: &toml::Table, sheets: &Sheets, import: &Import, origin
             out += &format!("# {} sheet: {source}\n", section.kind.title());
         }
     }
+    if let Some(a) = &sheets.arcsim {
+        let source = a.text.get("source").cloned().unwrap_or_else(|| a.origin());
+        out += &format!("# ARCSim material: {source}\n# The projection onto Rosette's keys and what it leaves out: docs/fabric-sheets.md, ARCSim materials.\n");
+    }
     out += "\n";
     out += &format!("name = {}\n", toml::Value::String(name));
     out += &format!("description = {}\n", toml::Value::String(description));
@@ -81,6 +85,10 @@ pub fn fabric_file(table: &toml::Table, sheets: &Sheets, import: &Import, origin
         let line = format!("{key} = {}", value(v));
         out += &if unit.is_empty() { format!("{line}\n") } else { format!("{line}    # {unit}\n") };
     }
+    if let Some(a) = &sheets.arcsim {
+        out += &arcsim_comments(a);
+        return out;
+    }
     out += "\n# The sheet this came from:\n";
     for section in sheets.sections() {
         out += &format!("#\n# [{}]\n", section.kind.section());
@@ -89,6 +97,35 @@ pub fn fabric_file(table: &toml::Table, sheets: &Sheets, import: &Import, origin
         }
         for (k, r) in &section.values {
             out += &format!("# {k} = {}\n", r.written);
+        }
+    }
+    out
+}
+
+/// The ARCSim material a fabric came from, as comments.
+fn arcsim_comments(a: &super::arcsim::ArcsimSection) -> String {
+    let m = &a.file_material;
+    let mut out = String::from("\n# The ARCSim material this came from:\n#\n# [arcsim]\n");
+    for (k, v) in &a.text {
+        out += &format!("# {k} = {}\n", toml::Value::String(v.clone()));
+    }
+    if let Some(path) = &a.data {
+        out += &format!("# data = {}\n", toml::Value::String(path.clone()));
+    }
+    let row = |r: &[f64]| format!("[{}]", r.iter().map(|v| format!("{v:e}")).collect::<Vec<_>>().join(", "));
+    out += &format!("# density = {}\n# stretching = [\n", m.density);
+    for r in &m.stretching {
+        out += &format!("#     {},\n", row(r));
+    }
+    out += "# ]\n# bending = [\n";
+    for r in &m.bending {
+        out += &format!("#     {},\n", row(r));
+    }
+    out += "# ]\n";
+    let k = a.multipliers;
+    for (name, v) in [("density_mult", k.density), ("stretching_mult", k.stretching), ("bending_mult", k.bending), ("thicken", k.thicken)] {
+        if v != 1.0 {
+            out += &format!("# {name} = {v}\n");
         }
     }
     out

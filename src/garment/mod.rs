@@ -247,8 +247,11 @@ fn check_placement(panel: &PanelConfig, units: Units) -> Result<(), GarmentError
     Ok(())
 }
 
+/// Every seam's two sides, and the number of parts each seam is cut into.
+type SeamSides = (Vec<(Side, Side)>, Vec<usize>);
+
 /// Resolves every seam's sides and the number of parts each is cut into.
-fn seam_sides(config: &GarmentConfig, names: &[(String, Vec<String>)], lengths: &[Vec<f64>], edge_length: f64) -> Result<(Vec<(Side, Side)>, Vec<usize>), GarmentError> {
+fn seam_sides(config: &GarmentConfig, names: &[(String, Vec<String>)], lengths: &[Vec<f64>], edge_length: f64) -> Result<SeamSides, GarmentError> {
     let metres = config.units.metres();
     if !(config.seam_ease.is_finite() && (0.0..0.5).contains(&config.seam_ease)) {
         return Err(GarmentError::new(format!("garment.seam_ease = {} must be a share between 0 and 0.5", config.seam_ease)));

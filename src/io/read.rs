@@ -22,6 +22,8 @@ pub enum FileKind {
     Obj,
     /// A CSV file Rosette wrote and reads back (the chart's drape reference).
     Csv,
+    /// An ARCSim material (JSON).
+    Arcsim,
 }
 
 impl FileKind {
@@ -33,6 +35,8 @@ impl FileKind {
             FileKind::Scene | FileKind::Fabric => 1 << 20,
             FileKind::Obj => 128 << 20,
             FileKind::Csv => 16 << 20,
+            // A material is under 2 kB; its comments may be long.
+            FileKind::Arcsim => 1 << 20,
         }
     }
 
@@ -43,6 +47,7 @@ impl FileKind {
             FileKind::Fabric => "fabric file",
             FileKind::Obj => "mesh file (OBJ)",
             FileKind::Csv => "CSV file",
+            FileKind::Arcsim => "ARCSim material (JSON)",
         }
     }
 
@@ -53,6 +58,7 @@ impl FileKind {
             FileKind::Scene | FileKind::Fabric => "toml",
             FileKind::Obj => "obj",
             FileKind::Csv => "csv",
+            FileKind::Arcsim => "json",
         }
     }
 }

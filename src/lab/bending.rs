@@ -29,20 +29,27 @@ impl PureBending {
 /// long (KES: 1 cm) and 1 cm wide on 1 mm edges, short enough that 1.5 cm⁻¹ bends it
 /// through 1.7 rad and fine enough that an element turns by 0.15 rad.
 pub fn pure_bending(fabric: &FabricConfig, direction: Direction) -> Result<PureBending, LabError> {
-    const TEST: &str = "KES pure bending";
     let mut readings = [(0.0, 0.0); 2];
     for (reading, curvature) in readings.iter_mut().zip(KES_CURVATURES) {
-        let config = scene_config(TEST, "arc", fabric, |c| {
-            c.cloth.warp_angle_deg = direction.warp_angle_deg();
-            c.cloth.length = 0.02;
-            c.cloth.width = 0.01;
-            c.mesh.edge_length = 0.001;
-            c.test.clamp_length = Some(0.002);
-            c.test.curvature = Some(curvature);
-        })?;
-        let m = run(TEST, config)?;
-        *reading = (measure(TEST, &m, "curvature")?, measure(TEST, &m, "moment")?);
+        *reading = bend_to(fabric, direction, curvature)?;
     }
     let [(k1, m1), (k2, m2)] = readings;
     Ok(PureBending { direction, rigidity: (m2 - m1) / (k2 - k1), readings })
+}
+
+/// Bends KES's strip (below) of `fabric` cut along `direction` to `curvature` (1/m) and
+/// reads (the curvature fitted to its middle half, the moment per unit width at midspan,
+/// N·m/m).
+pub fn bend_to(fabric: &FabricConfig, direction: Direction, curvature: f64) -> Result<(f64, f64), LabError> {
+    const TEST: &str = "KES pure bending";
+    let config = scene_config(TEST, "arc", fabric, |c| {
+        c.cloth.warp_angle_deg = direction.warp_angle_deg();
+        c.cloth.length = 0.02;
+        c.cloth.width = 0.01;
+        c.mesh.edge_length = 0.001;
+        c.test.clamp_length = Some(0.002);
+        c.test.curvature = Some(curvature);
+    })?;
+    let m = run(TEST, config)?;
+    Ok((measure(TEST, &m, "curvature")?, measure(TEST, &m, "moment")?))
 }

@@ -7,7 +7,8 @@
 //! - [`cantilever_bending_length`]: half the overhang at which a 25 mm strip's tip meets
 //!   the 41.5° plane (ASTM D1388, BS 3356).
 //! - [`tensile_pull`]: a strip pulled to a strain, its stress–strain curve (the fabric
-//!   card's bias pull).
+//!   card's bias pull); [`strain_pull`] the same on any strip, sampled every step.
+//! - [`arcsim::readback`]: an ARCSim material's samples read back by pulls and bends.
 //!
 //! Definitions and units: docs/references.md §8. Each test builds on a bundled scene
 //! (tensile-warp, arc, shear-buckling, cantilever), takes the fabric as given and reports
@@ -15,17 +16,18 @@
 //! Nothing here reads the fabric's own parameters back as a result: where a test needs a
 //! starting guess (the cantilever's first overhang) it only shortens the search.
 
+pub mod arcsim;
 mod bending;
 mod cantilever;
 pub mod readback;
 mod shear;
 mod tensile;
 
-pub use bending::{PureBending, pure_bending};
+pub use bending::{PureBending, bend_to, pure_bending};
 pub use cantilever::{CantileverTest, cantilever_bending_length};
 pub use readback::{LabRuns, Property, ReadBack, readback, readback_with};
 pub use shear::{ShearTest, shear};
-pub use tensile::{KesTensile, TensilePull, kes_tensile, tensile_pull};
+pub use tensile::{KesTensile, Strip, TensilePull, kes_tensile, load_at, strain_pull, tensile_pull};
 
 use crate::scene::preset::FabricConfig;
 use crate::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};

@@ -93,6 +93,71 @@ pub fn kes_tensile(fabric: &FabricConfig, direction: Direction) -> Result<KesTen
     Err(LabError::NoReading { test: TEST, message: "the strip did not reach 500 gf/cm by 100 % strain".into() })
 }
 
+/// A strip's size for [`strain_pull`], m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Strip {
+    pub length: f64,
+    pub width: f64,
+    /// Mesh edge length.
+    pub edge: f64,
+}
+
+impl Strip {
+    /// The KES and ISO rig's strip: 10 cm between the clamps, 5 cm wide, on 5 mm edges.
+    pub const RIG: Strip = Strip { length: 0.10, width: 0.05, edge: 0.005 };
+    /// A long strip for bias pulls: 20 cm by 2.5 cm on 5 mm edges. A strip cut off the
+    /// fabric's axes shears as it stretches; held at both ends, the shear is confined to the
+    /// ends, and the middle half the extensometer reads pulls nearly as a free strip would.
+    pub const LONG: Strip = Strip { length: 0.20, width: 0.025, edge: 0.005 };
+}
+
+/// Pulls `strip` of `fabric` cut along `direction` at the rig's 1 mm/s to `max_strain` and
+/// returns its curve sampled every step, [extensometer strain over the middle half, the
+/// moving clamp's load per unit width in N/m], from the unloaded start.
+pub fn strain_pull(fabric: &FabricConfig, direction: Direction, max_strain: f64, strip: Strip) -> Result<Vec<[f64; 2]>, LabError> {
+    const TEST: &str = "strain pull";
+    if !(max_strain.is_finite() && max_strain > 0.0 && max_strain <= 1.0) {
+        return Err(LabError::Setup { test: TEST, message: format!("the strain to pull to must be in (0, 1], got {max_strain}") });
+    }
+    let config = scene_config(TEST, "tensile-warp", fabric, |c| {
+        c.cloth.warp_angle_deg = direction.warp_angle_deg();
+        c.cloth.length = strip.length;
+        c.cloth.width = strip.width;
+        c.mesh.edge_length = strip.edge;
+        c.test.max_strain = Some(max_strain);
+        c.scene.duration = max_strain * strip.length / c.test.speed.unwrap_or(0.001);
+        c.scene.settle_speed = None;
+    })?;
+    let mut scene = Scene::build(config).map_err(|e| LabError::Setup { test: TEST, message: e.to_string() })?;
+    let rest = scene.model.rest.clone();
+    let moving: Vec<usize> = (0..rest.len()).filter(|&v| rest[v].x > strip.length - 1e-9).collect();
+    let columns = Columns::new(&rest, strip.length, strip.edge);
+    let (lo, hi) = (columns.nearest(0.25 * strip.length), columns.nearest(0.75 * strip.length));
+    let gauge = columns.rest_x[hi] - columns.rest_x[lo];
+    let mean_x = |x: &[DVec3], col: usize| columns.vertices[col].iter().map(|&v| x[v as usize].x).sum::<f64>() / columns.vertices[col].len() as f64;
+    let mut curve = vec![[0.0, 0.0]];
+    let mut f = vec![DVec3::ZERO; rest.len()];
+    while scene.state.time < scene.config.scene.duration - 1e-9 {
+        scene.step().map_err(|e| LabError::Diverged { test: TEST, message: e.to_string() })?;
+        f.iter_mut().for_each(|fi| *fi = DVec3::ZERO);
+        scene.model.forces(&scene.state.x, &mut f);
+        let load = -moving.iter().map(|&v| f[v].x).sum::<f64>() / strip.width;
+        let strain = (mean_x(&scene.state.x, hi) - mean_x(&scene.state.x, lo)) / gauge - 1.0;
+        curve.push([strain, load]);
+    }
+    Ok(curve)
+}
+
+/// The load on a sampled pull curve at `strain`, by linear interpolation between steps.
+pub fn load_at(curve: &[[f64; 2]], strain: f64) -> Option<f64> {
+    let i = curve.iter().position(|p| p[0] >= strain)?;
+    if i == 0 {
+        return Some(curve[0][1]);
+    }
+    let (a, b) = (curve[i - 1], curve[i]);
+    Some(a[1] + (strain - a[0]) / (b[0] - a[0]) * (b[1] - a[1]))
+}
+
 /// What a strip pull to a given strain reports: the tensile rig's own measures.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TensilePull {

@@ -35,7 +35,7 @@ pub const SCENES: &[Bundled] = bundled!("";
     "skirt-circle", "skirt-gored-straight", "skirt-gored-bias", "shift-dress");
 
 /// Bundled fabrics.
-pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk", "wool-plain-fast", "wool-worsted", "wool-flannel", "cotton-poplin", "cotton-oxford", "cotton-lawn", "denim-14oz");
+pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk", "wool-plain-fast", "wool-worsted", "wool-flannel", "cotton-poplin", "cotton-oxford", "cotton-lawn", "denim-14oz", "11oz-black-denim", "royal-target", "white-dots-on-blk", "pink-ribbon-brown");
 
 /// Why a preset could not be loaded. Every message names the file and, where it can, the key.
 #[derive(Debug, Error)]

@@ -126,10 +126,10 @@ impl ScalarCsr {
         find_slot(&self.row_start, &self.cols, row, col)
     }
 
-    /// The slot of (row, col), or Err where the pattern has no such entry.
-    pub fn find(&self, row: u32, col: u32) -> Result<usize, ()> {
+    /// The slot of (row, col), or None where the pattern has no such entry.
+    pub fn find(&self, row: u32, col: u32) -> Option<usize> {
         let (s, e) = (self.row_start[row as usize] as usize, self.row_start[row as usize + 1] as usize);
-        self.cols[s..e].binary_search(&col).map(|k| s + k).map_err(|_| ())
+        self.cols[s..e].binary_search(&col).ok().map(|k| s + k)
     }
 
     /// y += A x, the scalar matrix acting on each coordinate; rows in parallel on large meshes.

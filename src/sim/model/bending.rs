@@ -223,6 +223,10 @@ fn subtract_quadratic_force(q: &ScalarCsr, x: &[DVec3], f: &mut [DVec3]) {
     }
 }
 
+/// An edge's gradient stencil (vertex, weight) in the frame of its first triangle, and
+/// the second triangle's placement in that frame (panels only).
+type EdgeStencil = (Vec<(u32, DVec2)>, Option<Placement>);
+
 /// Builds every triangle's bending stencil: its surface Hessian x_,ij as a linear
 /// combination of nearby vertex positions.
 ///
@@ -308,7 +312,7 @@ fn stencils(triangles: &[[u32; 3]], n: usize, areas: &[f64], rest: &RestFrames, 
     // One gradient stencil per edge, shared by its triangles (for panels, in the frame of
     // the edge's first triangle, with the second triangle's placement in it), and the
     // rest points of the edge's hinge quad.
-    let mut gradient_of_edge: HashMap<[u32; 2], (Vec<(u32, DVec2)>, Option<Placement>)> = HashMap::new();
+    let mut gradient_of_edge: HashMap<[u32; 2], EdgeStencil> = HashMap::new();
     let mut hinge_points: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
     for (&edge, owners) in &edge_owner {
         let frame = frame_of(edge, owners[0].0);
@@ -347,7 +351,7 @@ fn stencils(triangles: &[[u32; 3]], n: usize, areas: &[f64], rest: &RestFrames, 
             // The edge's second triangle reads the shared gradient in its own frame.
             let turn = second.filter(|_| edge_owner[&key][0].0 != t);
             for &(v, c) in stencil {
-                let c = turn.map_or(c, |p| p.to_own(c));
+                let c = turn.map_or(c, |p| p.in_own_frame(c));
                 let w = [ln.x * c.x / area, ln.y * c.y / area, 0.5 * (ln.x * c.y + ln.y * c.x) / area];
                 match weights.iter_mut().find(|(u, _)| *u == v) {
                     Some((_, acc)) => (0..3).for_each(|i| acc[i] += w[i]),

@@ -36,13 +36,13 @@ impl Placement {
     }
 
     /// A chart-frame gradient weight (a covector) in the triangle's own frame: Rᵀ c.
-    pub fn to_own(&self, c: DVec2) -> DVec2 {
+    pub fn in_own_frame(&self, c: DVec2) -> DVec2 {
         DVec2::new(self.rotation.x * c.x + self.rotation.y * c.y, -self.rotation.y * c.x + self.rotation.x * c.y)
     }
 
     /// A chart point in the triangle's own frame: Rᵀ (p − offset).
     pub fn point_to_own(&self, p: DVec2) -> DVec2 {
-        self.to_own(p - self.offset)
+        self.in_own_frame(p - self.offset)
     }
 }
 

@@ -326,7 +326,7 @@ impl Model {
                 if r == c {
                     let slot = bending.slot(r, r);
                     bending.values[slot] += v;
-                } else if let Ok(slot) = bending.find(r, c) {
+                } else if let Some(slot) = bending.find(r, c) {
                     bending.values[slot] += v;
                 } else {
                     let slot = bending.slot(r, r);

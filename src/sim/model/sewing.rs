@@ -166,7 +166,9 @@ mod tests {
         let mesh = Mesh::rectangle(0.1, 0.06, 0.01, Pattern::Alternating, 1).unwrap();
         let options = PhysicsOptions::default();
         let whole = Model::new(&mesh, &fabric(), warp, options).unwrap();
-        let turn = DVec2::from_angle(0.5236);
+        // The right panel is drawn turned by 30°.
+        const TURN: f64 = std::f64::consts::FRAC_PI_6;
+        let turn = DVec2::from_angle(TURN);
         let moved = |p: DVec2| turn.rotate(p) + DVec2::new(0.3, -0.2);
         let right = |t: &[u32; 3]| t.iter().map(|&v| mesh.rest[v as usize].x).sum::<f64>() / 3.0 > 0.05;
         // The right panel's pattern is the moved copy; its warp in its own drawing is the
@@ -175,7 +177,7 @@ mod tests {
             .triangles
             .iter()
             .map(|t| {
-                let (p, grain) = if right(t) { (t.map(|v| moved(mesh.rest[v as usize])), warp + 0.5236) } else { (t.map(|v| mesh.rest[v as usize]), warp) };
+                let (p, grain) = if right(t) { (t.map(|v| moved(mesh.rest[v as usize])), warp + TURN) } else { (t.map(|v| mesh.rest[v as usize]), warp) };
                 p.map(|q| DVec2::from_angle(-grain).rotate(q))
             })
             .collect();
