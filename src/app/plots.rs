@@ -85,6 +85,8 @@ pub fn default_series(kind: SceneKind) -> &'static str {
         SceneKind::Drape => "drape_coefficient",
         // The hem falls as the sewn garment drapes on the form.
         SceneKind::Garment => "hem_height_mean",
+        // The period settles as the free edge crosses the plumb line.
+        SceneKind::Swing => "swing_period",
     }
 }
 
@@ -134,6 +136,23 @@ pub fn test_plot(ui: &mut egui::Ui, snapshot: &Snapshot) -> bool {
         if reference.is_none() {
             ui.small("Off-axis pull: the sheet shears and necks; no closed-form reference for nonlinear curves.");
         }
+        return true;
+    }
+    if let Measures::Swing(swing) = &*snapshot.measures {
+        // The chain's first mode released from rest: a cos(2πt/T₁) (docs/references.md §10).
+        let amplitude = config.test.swing_amplitude.unwrap_or(0.0);
+        let end = swing.bottom_history.last().map_or(0.0, |p| p[0]);
+        let chain: Vec<[f64; 2]> =
+            (0..=400).map(|i| end * i as f64 / 400.0).map(|t| [t, amplitude * (std::f64::consts::TAU * t / swing.chain_period).cos()]).collect();
+        let measured = match swing.swing_period {
+            Some(p) => format!("period {p:.4} s against the chain's {:.4} s ({:+.2} %)", swing.chain_period, 100.0 * (p / swing.chain_period - 1.0)),
+            None => format!("the chain's period {:.4} s; the swing's needs two half periods", swing.chain_period),
+        };
+        ui.label(format!("Free edge's sideways displacement: {measured}"));
+        Plot::new("swing_live").height(180.0).legend(Legend::default()).x_axis_label("time (s)").y_axis_label("displacement (m)").show(ui, |plot| {
+            plot.line(Line::new("hanging chain", PlotPoints::from(chain)).style(LineStyle::dashed_loose()).width(2.0));
+            plot.line(Line::new("measured", PlotPoints::from(swing.bottom_history.clone())).width(2.0));
+        });
         return true;
     }
     if let Measures::Euler(measured) = &*snapshot.measures {

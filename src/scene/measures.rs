@@ -27,6 +27,7 @@ pub enum Measures {
     Shear(ShearMeasures),
     /// Before `Drape`: a garment's JSON holds fields no drape has, a drape's lacks them.
     Garment(super::garment::rig::GarmentMeasures),
+    Swing(super::swing::SwingMeasures),
     Drape(DrapeMeasures),
 }
 
@@ -254,6 +255,10 @@ impl Measures {
         if let Measures::Garment(m) = self { Some(m) } else { None }
     }
 
+    pub fn swing(&self) -> Option<&super::swing::SwingMeasures> {
+        if let Measures::Swing(m) = self { Some(m) } else { None }
+    }
+
     /// The scalar measures that have a finite value now, by name, in the JSON's key order
     /// (definitions, which are text, and series are left out).
     pub fn scalars(&self) -> Vec<(&'static str, Scalar)> {
@@ -321,6 +326,11 @@ impl Measures {
                 ("shadow_area", Some(Real(m.shadow_area))),
                 ("waist_area", Some(Real(m.waist_area))),
             ],
+            Measures::Swing(m) => vec![
+                ("chain_period", Some(Real(m.chain_period))),
+                ("half_periods", Some(Count(m.half_periods))),
+                ("swing_period", m.swing_period.map(Real)),
+            ],
         };
         all.into_iter().filter_map(|(name, value)| Some((name, value.filter(|v| v.value().is_finite())?))).collect()
     }
@@ -353,6 +363,7 @@ impl Measures {
                 let rows: Vec<[f64; 3]> = m.history.iter().map(|&(t, dc, nodes)| [t, dc, nodes as f64]).collect();
                 vec![series("history", &["time_s", "drape_coefficient", "nodes"], &rows)]
             }
+            Measures::Swing(m) => vec![series("bottom_history", &["time_s", "displacement_m"], &m.bottom_history)],
             Measures::Cantilever(_) | Measures::Arc(_) | Measures::Shear(_) | Measures::Garment(_) => Vec::new(),
         }
     }

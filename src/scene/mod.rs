@@ -13,6 +13,7 @@ pub mod props;
 pub mod rigs;
 pub mod run;
 pub mod strip;
+pub mod swing;
 pub mod validate;
 
 pub use measures::Measures;
@@ -112,7 +113,10 @@ impl Scene {
         }
         let mut model = Model::new(&mesh, &fabric, warp, options)?;
         let origin = DVec3::from_array(c.position);
-        let mut x: Vec<DVec3> = mesh.rest.iter().map(|p| origin + DVec3::new(p.x, p.y, 0.0)).collect();
+        let mut x: Vec<DVec3> = match level_config.test.swing_amplitude.filter(|_| level_config.scene.kind == SceneKind::Swing) {
+            Some(amplitude) => swing::hanging_positions(&mesh.rest, origin, c.length, amplitude),
+            None => mesh.rest.iter().map(|p| origin + DVec3::new(p.x, p.y, 0.0)).collect(),
+        };
         let rig = Rig::attach(&level_config, &mut model, &x, clamp_band)?;
         if let Some(amplitude) = level_config.test.perturbation {
             let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(level_config.scene.seed);
@@ -206,7 +210,7 @@ impl Scene {
 /// the clamp band's length.
 fn strip_mesh(config: &SceneConfig) -> Result<(Mesh, f64), SceneError> {
     let (c, h) = (&config.cloth, config.mesh.edge_length);
-    let clamped = matches!(config.scene.kind, SceneKind::Cantilever | SceneKind::Arc);
+    let clamped = matches!(config.scene.kind, SceneKind::Cantilever | SceneKind::Arc | SceneKind::Swing);
     let (clamp_band, spacing) = if clamped {
         let cells = (c.length / h).round().max(1.0);
         let spacing = c.length / cells;

@@ -32,7 +32,7 @@ macro_rules! bundled {
 pub const SCENES: &[Bundled] = bundled!("";
     "tensile-warp", "tensile-weft", "tensile-bias", "cantilever", "arc", "euler-buckling", "shear-buckling",
     "cusick-drape", "cusick-drape-30", "tablecloth", "sphere-drop",
-    "skirt-circle", "skirt-gored-straight", "skirt-gored-bias", "shift-dress");
+    "skirt-circle", "skirt-gored-straight", "skirt-gored-bias", "shift-dress", "swing");
 
 /// Bundled fabrics.
 pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk", "wool-plain-fast", "wool-worsted", "wool-flannel", "cotton-poplin", "cotton-oxford", "cotton-lawn", "denim-14oz", "11oz-black-denim", "royal-target", "white-dots-on-blk", "pink-ribbon-brown");
@@ -71,6 +71,9 @@ pub enum SceneKind {
     Drape,
     /// Pattern pieces sewn into a garment on a dress form (`[garment]`, docs/garments.md).
     Garment,
+    /// A strip hung from its top edge, released in the hanging chain's first mode; its
+    /// period against the chain's (docs/references.md §10).
+    Swing,
 }
 
 /// A complete scene description, after the fabric file and overrides are merged.
@@ -376,6 +379,9 @@ pub struct TestSection {
     pub support_diameter: Option<f64>,
     /// Drape: size of a rectangular support (a table top), [x, y] m, for the drape coefficient.
     pub support_size: Option<[f64; 2]>,
+    /// Swing: the free edge's sideways displacement at the start, m (the strip starts in the
+    /// hanging chain's first mode).
+    pub swing_amplitude: Option<f64>,
 }
 
 /// How the shear rig's moving grip travels.

@@ -18,6 +18,7 @@ pub enum Rig {
     Shear(Shear),
     Drape(Drape),
     Garment(Box<super::garment::rig::GarmentRig>),
+    Swing(super::swing::Swing),
 }
 
 pub struct Drape {
@@ -201,6 +202,7 @@ impl Rig {
                 Rig::Euler(Euler { left, right, columns, width, length, history: Vec::new(), speed })
             }
             SceneKind::Garment => return Err(SceneError::Setup("garment scenes build their own rig (scene::garment)".into())),
+            SceneKind::Swing => Rig::Swing(super::swing::Swing::attach(config, model, x, super::GRAVITY)?),
             SceneKind::ShearBuckling => {
                 let clamped = vertices_where(&rest, |p| p.y < ON_EDGE);
                 let moving = vertices_where(&rest, |p| p.y > width - ON_EDGE);
@@ -260,6 +262,7 @@ impl Rig {
                 let imbalance = unbalanced / (r.euler_load(model) * r.width);
                 r.history.push((state.time, shortening, force, amplitude, count_half_waves(&z, 0.2), imbalance));
             }
+            Rig::Swing(r) => r.sample(state),
             _ => {}
         }
     }
@@ -368,6 +371,7 @@ impl Rig {
             }
             Rig::Shear(r) => Measures::Shear(shear_measures(r, model, state)),
             Rig::Garment(r) => Measures::Garment(r.finish(model, state)),
+            Rig::Swing(r) => Measures::Swing(r.finish()),
             Rig::Drape(r) => {
                 let (shadow, dc, nodes) = r.measure(model, state, 1024);
                 let radius_min = shadow.outline.iter().map(|o| o.1).fold(f64::INFINITY, f64::min);

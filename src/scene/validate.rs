@@ -88,6 +88,7 @@ const TEST_KEYS: &[(&str, &[SceneKind])] = {
         ("clamp_radius", &[Drape]),
         ("support_diameter", &[Drape]),
         ("support_size", &[Drape]),
+        ("swing_amplitude", &[Swing]),
     ]
 };
 
@@ -330,6 +331,7 @@ fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
         ("clamp_radius", t.clamp_radius.is_some()),
         ("support_diameter", t.support_diameter.is_some()),
         ("support_size", t.support_size.is_some()),
+        ("swing_amplitude", t.swing_amplitude.is_some()),
     ];
     for (key, kinds) in TEST_KEYS {
         if given.iter().any(|(k, set)| k == key && *set) && !kinds.contains(&kind) {
@@ -382,6 +384,19 @@ fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
             }
         }
         SceneKind::Cantilever | SceneKind::Drape => {}
+        SceneKind::Swing => {
+            let a = need("test.swing_amplitude", t.swing_amplitude)?;
+            // The chain's small-amplitude period holds for swings small against the length.
+            if a > 0.1 * length {
+                return Err(invalid(
+                    "test.swing_amplitude",
+                    format!("test.swing_amplitude = {} m is more than a tenth of the strip's {} m: the swing would not be small; use at most {}", short(a), short(length), short(0.1 * length)),
+                ));
+            }
+            if t.perturbation.is_some() {
+                return Err(invalid("test.perturbation", "test.perturbation has no effect on a swing scene (it starts in the chain's mode); remove it".into()));
+            }
+        }
         SceneKind::Garment => {
             if t.perturbation.is_some() {
                 return Err(invalid("test.perturbation", "test.perturbation has no effect on a garment scene (its panels start where their placement puts them); remove it".into()));
