@@ -2,14 +2,15 @@
 //! settled coarse to fine at long steps lands inside the exact path's scatter between random
 //! starts and inside its fabric's measured class (docs/references.md §7), clean (no
 //! self-intersection, no penetration); a cloth dropped at long steps, its contact penalty
-//! rescaled, stays out of its prop; scenes that do not settle (the laboratory's rigs) run
-//! exactly as on the exact path; and a path the integrator cannot take is refused.
+//! rescaled, stays out of its prop, and so does a cloth in motion on a ball; scenes that do
+//! not settle (the laboratory's rigs) run exactly as on the exact path; and a path the
+//! integrator cannot take is refused.
 
 mod common;
 
 use common::{drape_coefficient, run, run_all};
 use rosette::scene::levels::schedule;
-use rosette::scene::{Metrics, Scene, load_scene};
+use rosette::scene::{Metrics, RunOptions, Scene, load_scene, run_scene};
 
 /// Issue 23's criterion: over the same seeds, the fast path's coefficients lie within 0.02
 /// of the exact path's range on the same mesh.
@@ -103,4 +104,26 @@ fn the_fast_path_with_an_explicit_integrator_is_refused() {
         Err(e) => e.to_string(),
     };
     assert!(message.contains("solver.path") && message.contains("solver.integrator"), "{message}");
+}
+
+/// A cloth dropped onto a ball and not watched for settling, the cloth simulators' common
+/// scene (docs/fast-path.md, Cloth in motion): the fast path runs it on its own mesh at the
+/// step for cloth in motion, four times the scene's, with the contact penalty raised to
+/// match, and every step converges with the cloth out of the ball and itself.
+#[test]
+fn a_cloth_in_motion_on_a_ball_takes_the_long_step_and_stays_out_of_it() {
+    let overrides: Vec<String> = ["mesh.edge_length=0.04", "scene.duration=0.6", "solver.path=fast"].map(String::from).to_vec();
+    let (mut config, _) = load_scene("sphere-drop", &overrides).unwrap();
+    config.scene.settle_speed = None;
+    let mut scene = Scene::build(config.clone()).unwrap();
+    let (m, error) = run_scene(&mut scene, "sphere-drop", RunOptions::default());
+    println!(
+        "sphere drop, 4 cm edges, fast, 0.6 s: dt {} s, {} Newton iterations, penetration {:?}, {:.2} s wall",
+        m.dt, m.newton_iterations, m.max_penetration, m.wall_seconds
+    );
+    assert!(error.is_none(), "{error:?}");
+    assert!(m.dt >= 4.0 * config.solver.dt * (1.0 - 1e-9), "the drop takes the long step: {} s", m.dt);
+    assert!(m.converged && m.stable);
+    assert_eq!(m.self_intersections, Some(0));
+    assert!(m.max_penetration.unwrap() < config.contact.thickness, "{:?}", m.max_penetration);
 }

@@ -168,6 +168,7 @@ impl Plan {
                 (Problem::Cantilever, vec![0.005], vec![0.02, 0.005]),
                 (Problem::Buckling, vec![0.01], vec![0.01]),
                 (Problem::Tensile, vec![0.01], vec![0.05, 0.01, 0.002]),
+                (Problem::Swing, vec![0.01], vec![0.016, 0.004]),
             ]
         } else {
             vec![
@@ -175,6 +176,7 @@ impl Plan {
                 (Problem::Buckling, vec![0.01, 0.006667, 0.005], vec![0.01, 0.004]),
                 (Problem::Tensile, vec![0.01, 0.005, 0.0025], vec![0.05, 0.01, 0.002]),
                 (Problem::Drape, vec![0.03, 0.0225, 0.0155], vec![0.008, 0.004]),
+                (Problem::Swing, vec![0.01, 0.005], vec![0.016, 0.008, 0.004, 0.002]),
             ]
         };
         for (problem, edges, dts) in problems {
@@ -196,6 +198,13 @@ impl Plan {
                 // chosen per level), beside exact Newton on the same meshes.
                 if matches!(problem, Problem::Cantilever | Problem::Drape) {
                     accuracy.push(Case { path: SolverPath::Fast, ..case(problem, ImplicitEuler, Step::Scene, edge) });
+                }
+                // The swing on the fast path's step for cloth in motion, with both implicit
+                // integrators: the error a long step makes on a moving cloth.
+                if problem == Problem::Swing {
+                    for integrator in [ImplicitEuler, Bdf2] {
+                        accuracy.push(Case { path: SolverPath::Fast, ..case(problem, integrator, Step::Scene, edge) });
+                    }
                 }
             }
         }

@@ -31,10 +31,13 @@ pub enum Problem {
     Tensile,
     /// Cusick drape, 30 cm specimen: drape coefficient against a fine-mesh run.
     Drape,
+    /// A strip swinging from its top edge: period against the hanging chain's
+    /// (docs/references.md §10), the one problem of the chart in motion.
+    Swing,
 }
 
 impl Problem {
-    pub const ALL: [Problem; 4] = [Self::Cantilever, Self::Buckling, Self::Tensile, Self::Drape];
+    pub const ALL: [Problem; 5] = [Self::Cantilever, Self::Buckling, Self::Tensile, Self::Drape, Self::Swing];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -42,6 +45,7 @@ impl Problem {
             Self::Buckling => "euler-buckling",
             Self::Tensile => "tensile",
             Self::Drape => "drape",
+            Self::Swing => "swing",
         }
     }
 
@@ -52,6 +56,7 @@ impl Problem {
             Self::Buckling => "midspan deflection vs elastica, relative",
             Self::Tensile => "worst stress vs input curve, relative",
             Self::Drape => "drape coefficient vs fine mesh, absolute",
+            Self::Swing => "swing period vs hanging chain, relative",
         }
     }
 
@@ -65,6 +70,7 @@ impl Problem {
             Self::Buckling => "euler-buckling",
             Self::Tensile => "tensile-warp",
             Self::Drape => "cusick-drape-30",
+            Self::Swing => "swing",
         }
     }
 
@@ -81,7 +87,7 @@ impl Problem {
             // Pulled to 6 % ten times faster than the preset: 0.6 s is still 500 times the
             // membrane wave's crossing time of the strip.
             Self::Tensile => &["test.speed=0.01", "scene.duration=0.6"],
-            Self::Drape => &[],
+            Self::Drape | Self::Swing => &[],
         }
     }
 }
@@ -282,6 +288,12 @@ fn measure_error(problem: Problem, config: &SceneConfig, measures: &Measures) ->
             Ok((worst, error))
         }
         Problem::Drape => Ok((measures.drape().ok_or_else(other_rig)?.drape_coefficient, None)),
+        Problem::Swing => {
+            let swing = measures.swing().ok_or_else(other_rig)?;
+            // A run that damped the swing out before two half periods has no period to compare.
+            let period = swing.swing_period.ok_or("the swing died out before two half periods: no period to compare")?;
+            Ok((period, Some((period - swing.chain_period).abs() / swing.chain_period)))
+        }
     }
 }
 

@@ -123,10 +123,12 @@ fn coarsest_edge(config: &SceneConfig) -> Result<f64, crate::sim::FabricError> {
 /// Newton's iteration limit on the fast path's long steps.
 const FAST_MAX_ITERATIONS: usize = 80;
 
-/// Whether the scene loads its cloth slowly: no props to land on, or props with gravity
-/// ramped up (a lowered specimen). Otherwise the cloth is dropped onto its props.
+/// Whether the scene loads its cloth slowly: no props to land on (except the swing, which
+/// moves freely throughout), or props with gravity ramped up (a lowered specimen).
+/// Otherwise the cloth is dropped onto its props, or swings, and is in motion at every step.
 fn quasi_static(config: &SceneConfig) -> bool {
-    config.props.is_empty() || config.scene.gravity_ramp.is_some()
+    let free_motion = config.scene.kind == super::SceneKind::Swing;
+    (config.props.is_empty() && !free_motion) || config.scene.gravity_ramp.is_some()
 }
 
 /// The configuration of one level: the scene's own, on a mesh of `edge_length` with the

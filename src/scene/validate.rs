@@ -83,7 +83,7 @@ const TEST_KEYS: &[(&str, &[SceneKind])] = {
         ("shear_angle_deg", &[ShearBuckling]),
         ("speed", &[Tensile, EulerBuckling, ShearBuckling]),
         ("curvature", &[Arc]),
-        ("clamp_length", &[Cantilever, Arc]),
+        ("clamp_length", &[Cantilever, Arc, Swing]),
         ("shear_kinematics", &[ShearBuckling]),
         ("clamp_radius", &[Drape]),
         ("support_diameter", &[Drape]),
