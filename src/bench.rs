@@ -61,6 +61,10 @@ pub struct BenchRow {
     pub settled: Option<bool>,
     pub max_penetration: Option<f64>,
     pub self_intersections: Option<usize>,
+    /// The step the run ended on, s.
+    pub dt: f64,
+    /// The swing's period against the hanging chain's, relative (swing scenes).
+    pub period_error: Option<f64>,
 }
 
 /// Triangles of a `cusick-drape` disc at edge length `edge` are about 875·(0.0155/edge)².
@@ -111,6 +115,10 @@ fn cases(quick: bool) -> Vec<Case> {
         // 1 m² cloth onto a sphere over its first 0.4 s (the fall and the wrap), on one thread.
         both(&mut out, "tablecloth, to settling", "tablecloth", vec![], None, None);
         both(&mut out, "sphere-drop, first 0.4 s", "sphere-drop", vec![], Some(0.4), Some(&[1]));
+        // The same drop on the fast path with the quasi-Newton minimizer
+        // (`solver.newton.minimizer`), the step design docs/fast-path.md measured against Newton.
+        let quasi_newton = vec!["solver.path=fast".to_string(), "solver.newton.minimizer=quasi-newton".into()];
+        out.push(Case { threads: Some(&[1]), ..case("sphere-drop, first 0.4 s, fast, quasi-newton", "sphere-drop", quasi_newton, Some(0.4), None) });
     }
     // The same window for every size, so that their costs compare: the first two 4 ms
     // steps of the lowering (gravity ramps up over 2 s), short enough for 80 000 triangles
@@ -130,6 +138,9 @@ fn cases(quick: bool) -> Vec<Case> {
             ));
         }
     }
+    // Cloth in motion with a known answer: the swing on both paths (its period against the
+    // hanging chain's is in the metrics), one thread.
+    both(&mut out, "swing", "swing", vec![], None, Some(&[1]));
     out
 }
 
@@ -181,6 +192,8 @@ fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
         settled: m.settled,
         max_penetration: m.max_penetration,
         self_intersections: m.self_intersections,
+        dt: m.dt,
+        period_error: m.measures.swing().and_then(|s| Some(s.swing_period? / s.chain_period - 1.0)),
     })
 }
 
@@ -244,6 +257,9 @@ fn summarise(rows: &[BenchRow]) {
         if let Some(paper) = r.paper_cpu_seconds_per_10ms {
             let ours = r.cpu_seconds_per_simulated_second * 0.01;
             outln!("{}: {ours:.5} CPU s per 10 ms, {:.0}x faster than the paper's {paper}", r.case, paper / ours);
+        }
+        if let Some(error) = r.period_error {
+            outln!("{}: period {:+.3} % against the hanging chain's, at {} s steps, {:.2} wall s per simulated s", r.case, 100.0 * error, r.dt, r.wall_seconds_per_simulated_second);
         }
         if let Some(two) = rows.iter().find(|o| o.case == r.case && o.threads == 2) {
             outln!("{}: 1 -> 2 threads, wall-clock speed-up {:.2}x", r.case, r.wall_seconds / two.wall_seconds);
@@ -324,12 +340,12 @@ fn csv_text(rows: &[BenchRow]) -> String {
         f,
         "case,threads,triangles,vertices,steps,simulated_seconds,wall_seconds,cpu_seconds_per_simulated_second,\
          wall_seconds_per_simulated_second,forces_share,solve_share,contact_share,solver_speedup_bound,newton_per_step,cg_per_newton,\
-         peak_memory_mb,paper_cpu_seconds_per_10ms,path,drape_coefficient,nodes,settled,max_penetration,self_intersections"
+         peak_memory_mb,paper_cpu_seconds_per_10ms,path,drape_coefficient,nodes,settled,max_penetration,self_intersections,dt,period_error"
     );
     for r in rows {
         let _ = writeln!(
             f,
-            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.case,
             r.threads,
             r.triangles,
@@ -352,7 +368,9 @@ fn csv_text(rows: &[BenchRow]) -> String {
             r.nodes.map_or(String::new(), |v| v.to_string()),
             r.settled.map_or(String::new(), |v| v.to_string()),
             r.max_penetration.map_or(String::new(), |v| v.to_string()),
-            r.self_intersections.map_or(String::new(), |v| v.to_string())
+            r.self_intersections.map_or(String::new(), |v| v.to_string()),
+            r.dt,
+            r.period_error.map_or(String::new(), |v| v.to_string())
         );
     }
     f

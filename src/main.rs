@@ -65,6 +65,11 @@ enum Command {
         /// with longer steps and Newton solved to the step's own accuracy (docs/solvers.md).
         #[arg(long)]
         fast: bool,
+        /// Print the run plan and exit without running: the step design resolved from the
+        /// scene's settings, its levels, and per level the mesh, integrator, step, Newton,
+        /// linear solver and contact settings.
+        #[arg(long)]
+        plan: bool,
         /// Write the cloth as glTF 2.0 binary (Blender, three.js): the final state, or with
         /// --export-frames an animation of the run.
         #[arg(long, value_name = "FILE.glb")]
@@ -301,9 +306,12 @@ fn dispatch(cli: Cli) -> ExitCode {
             FabricAction::Check { fabric } => cli::fabric::check(&fabric),
             FabricAction::Export { fabric, arcsim: _, out, force } => cli::arcsim::export(&fabric, out.as_deref(), force),
         },
-        Some(Command::Run { preset, mut overrides, duration, metrics, outline, step_log, max_steps, max_wall, fast, export, export_frames, force, screenshot }) => {
+        Some(Command::Run { preset, mut overrides, duration, metrics, outline, step_log, max_steps, max_wall, fast, plan, export, export_frames, force, screenshot }) => {
             if fast {
                 overrides.push(FAST_PATH.to_string());
+            }
+            if plan {
+                return cli::run::print_plan(&preset, &overrides, duration);
             }
             let outputs = RunOutputs {
                 metrics: metrics.as_deref(),

@@ -377,7 +377,7 @@ fn bench_quick_writes_one_row_per_case() {
     }
     // The case name is quoted (it may hold commas); the columns after it are numbers.
     let rows: Vec<Vec<&str>> = lines.map(|l| l[l.rfind("\",").expect("a quoted case") + 2..].split(',').collect()).collect();
-    assert_eq!(rows.len(), 9, "three Table 1 scenes, the drape to settling on both solver paths, and two drape sizes with two solvers each:\n{csv}");
+    assert_eq!(rows.len(), 11, "three Table 1 scenes, the drape to settling on both solver paths, two drape sizes with two solvers each and the swing on both paths:\n{csv}");
     let column = |row: &Vec<&str>, key: &str| -> f64 {
         let i = header.iter().position(|h| *h == key).unwrap();
         row[i - 1].parse().unwrap_or(f64::NAN)
@@ -406,8 +406,14 @@ fn bench_quick_writes_one_row_per_case() {
     assert!(names[3].ends_with(", exact") && names[4].ends_with(", fast"), "{names:?}");
     assert_eq!(column(&rows[3], "triangles"), column(&rows[4], "triangles"));
     for row in &rows[3..5] {
-        assert_eq!(row[row.len() - 3], "true", "settled: {row:?}");
+        assert_eq!(row[header.iter().position(|h| *h == "settled").unwrap() - 1], "true", "settled: {row:?}");
         let dc = column(row, "drape_coefficient");
         assert!(dc > 0.0 && dc < 1.0, "{row:?}");
+    }
+    // The swing on both paths, the fast one at its longer step for cloth in motion.
+    assert!(names[9].starts_with("swing, exact") && names[10].starts_with("swing, fast"), "{names:?}");
+    assert!(column(&rows[10], "dt") > column(&rows[9], "dt"), "{:?}", &rows[9..]);
+    for row in &rows[9..] {
+        assert!(column(row, "period_error").abs() < 0.01, "the swing's period against the hanging chain's: {row:?}");
     }
 }

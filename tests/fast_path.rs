@@ -9,7 +9,7 @@
 mod common;
 
 use common::{drape_coefficient, run, run_all};
-use rosette::scene::levels::schedule;
+use rosette::scene::plan::{Design, RunPlan};
 use rosette::scene::{Metrics, RunOptions, Scene, load_scene, run_scene};
 
 /// Issue 23's criterion: over the same seeds, the fast path's coefficients lie within 0.02
@@ -25,8 +25,10 @@ fn fast_drape_lies_within_the_exact_paths_seed_scatter_and_its_measured_class() 
     let fabric = "fabric.preset=denim".to_string();
     let mesh = "mesh.edge_length=0.006".to_string();
     let (config, _) = load_scene("cusick-drape-30", &[fabric.clone(), mesh.clone(), "solver.path=fast".into()]).unwrap();
-    let levels = schedule(&config).unwrap().expect("a drape settles, so the fast path has levels");
-    assert!(levels.len() >= 2, "6 mm edges should settle through a coarser mesh first: {levels:?}");
+    let plan = RunPlan::resolve(&config).unwrap();
+    assert_eq!(plan.design, Design::Settling, "a drape settles, so the fast path has levels");
+    let edges: Vec<f64> = plan.levels.iter().map(|l| l.edge_length).collect();
+    assert!(edges.len() >= 2, "6 mm edges should settle through a coarser mesh first: {edges:?}");
 
     let sets = [("exact", 1), ("exact", 2), ("fast", 1), ("fast", 2)]
         .iter()

@@ -7,6 +7,7 @@ use crate::ScreenshotArgs;
 use rosette::io::guard::Plan;
 use rosette::io::number::short;
 use rosette::io::write::Output;
+use rosette::scene::plan::RunPlan;
 use rosette::scene::preset::{RunFlags, load_scene_with};
 use rosette::scene::{RunOptions, Scene, SceneConfig, StepRecord, possible, run_scene};
 use rosette::{errln, outln, render};
@@ -85,6 +86,21 @@ fn plan_outputs(config: &SceneConfig, spec: &str, outputs: &RunOutputs, shot: &S
 
 /// Loads the scene for `run` and checks everything before any work: the flags, the scene,
 /// the outputs and the props' start. The scene is built.
+/// `rosette run SCENE --plan`: the scene's run plan in words, nothing run or written.
+pub fn print_plan(spec: &str, overrides: &[String], duration: Option<f64>) -> ExitCode {
+    let flags = RunFlags { duration, max_steps: None };
+    let plan = load_scene_with(spec, overrides, &flags)
+        .map_err(|e| e.to_string())
+        .and_then(|(config, _)| Ok((RunPlan::resolve(&config).map_err(|e| format!("{spec}: {e}"))?, config)));
+    match plan {
+        Ok((plan, config)) => {
+            outln!("{spec}: {}", plan.describe(&config).trim_end());
+            ExitCode::SUCCESS
+        }
+        Err(e) => bad_input(e),
+    }
+}
+
 fn prepare(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutputs, shot: &ScreenshotArgs) -> Result<Scene, String> {
     if let Some(d) = limits.duration.filter(|d| !(d.is_finite() && *d > 0.0)) {
         return Err(format!("--duration must be a positive number of seconds, got {}", short(d)));

@@ -19,12 +19,12 @@
 //! run at the fast path's long time step (`solver.fast.dt`), on which implicit Euler is as
 //! stable as on the exact path's; a scene whose mesh is coarser than that keeps its own
 //! step. A cloth dropped onto props (no gravity ramp) takes the long step on every level,
-//! with the contact penalty rescaled to keep its stiffness ([`level_config`]), and on every
+//! with the contact penalty rescaled to keep its stiffness (`plan::level`), and on every
 //! level Newton stops at the step's own accuracy (`solver.fast.error_share`).
 
 use super::run::SettleWatch;
-use super::{Scene, SceneConfig, SceneError};
-use crate::sim::{Mesh, PreconditionerChoice};
+use super::Scene;
+use crate::sim::Mesh;
 use serde::{Deserialize, Serialize};
 
 /// Which step design a scene runs.
@@ -80,103 +80,6 @@ impl Default for FastSettings {
     fn default() -> Self {
         Self { dt: 0.064, drop_dt: 0.016, coarsest_edge_share: 0.5, error_share: 0.1 }
     }
-}
-
-/// The edge lengths of the fast path's levels, coarsest first and the scene's own last;
-/// None where the scene runs on its own mesh and settings throughout: the exact path, and
-/// on the fast path a scene that does not settle (the laboratory rigs, whose loads are
-/// the experiment).
-pub fn schedule(config: &SceneConfig) -> Result<Option<Vec<f64>>, SceneError> {
-    let solver = &config.solver;
-    if solver.path != SolverPath::Fast || (config.scene.settle_speed.is_none() && quasi_static(config)) {
-        return Ok(None);
-    }
-    if solver.integrator.is_explicit() {
-        return Err(SceneError::Setup(
-            "solver.path = \"fast\" takes implicit steps, which solver.integrator = \"symplectic-euler\" cannot; \
-             use solver.integrator = \"implicit-euler\" or solver.path = \"exact\""
-                .into(),
-        ));
-    }
-    let mut edges = vec![config.mesh.edge_length];
-    if config.scene.settle_speed.is_none() {
-        // A cloth in motion that is not watched for settling: its own mesh throughout (the
-        // levels' transfers happen when a level settles), with the fast path's step.
-        return Ok(Some(edges));
-    }
-    let coarsest = coarsest_edge(config).map_err(crate::sim::ModelError::from)?;
-    while 2.0 * edges[0] <= coarsest {
-        edges.insert(0, 2.0 * edges[0]);
-    }
-    Ok(Some(edges))
-}
-
-/// The coarsest edge that still resolves the scene's folds: `solver.fast.coarsest_edge_share`
-/// of the fabric's bending length (B/w)^(1/3), m (the weaker direction's).
-fn coarsest_edge(config: &SceneConfig) -> Result<f64, crate::sim::FabricError> {
-    let fabric = config.material()?;
-    let weight = fabric.weight_per_area(super::GRAVITY);
-    let bending_length = (fabric.bending_warp.min(fabric.bending_weft) / weight).cbrt();
-    Ok(config.solver.fast.coarsest_edge_share * bending_length)
-}
-
-/// Newton's iteration limit on the fast path's long steps.
-const FAST_MAX_ITERATIONS: usize = 80;
-
-/// Whether the scene loads its cloth slowly: no props to land on (except the swing, which
-/// moves freely throughout), or props with gravity ramped up (a lowered specimen).
-/// Otherwise the cloth is dropped onto its props, or swings, and is in motion at every step.
-fn quasi_static(config: &SceneConfig) -> bool {
-    let free_motion = config.scene.kind == super::SceneKind::Swing;
-    (config.props.is_empty() && !free_motion) || config.scene.gravity_ramp.is_some()
-}
-
-/// The configuration of one level: the scene's own, on a mesh of `edge_length` with the
-/// fast path's settings; the scene's own unchanged for None.
-pub fn level_config(config: &SceneConfig, edge_length: Option<f64>) -> SceneConfig {
-    let mut level = config.clone();
-    if let Some(edge) = edge_length {
-        let fast = &config.solver.fast;
-        level.mesh.edge_length = edge;
-        // Long steps follow a quasi-static load through near-equilibria, which holds where
-        // the mesh resolves the folds. On a mesh whose elements are as wide as the folds the
-        // drape depends on the path at the scale of an element, and the scene keeps its step.
-        // A cloth dropped onto a prop takes the shorter `drop_dt` on any mesh (its folds
-        // depend on the fall's path at every step), with the contact penalty's factor raised
-        // with the square of the step so that its stiffness c·m/Δt² stays the scene's: a
-        // vertex arriving at speed v then stops within v·Δt/√c of the same layer as at the
-        // scene's own step.
-        let resolved = coarsest_edge(config).is_ok_and(|coarsest| edge <= coarsest * (1.0 + 1e-9));
-        let slow = quasi_static(config);
-        let long_dt = if slow { resolved.then_some(fast.dt) } else { Some(fast.drop_dt) };
-        if let Some(long_dt) = long_dt.filter(|&d| d > config.solver.dt) {
-            level.solver.dt = long_dt;
-            if !slow {
-                level.contact.stiffness *= (long_dt / config.solver.dt).powi(2);
-            }
-            // The first step after a transfer relaxes, in one long step, what the coarser
-            // mesh could not resolve; Newton gets the iterations that takes.
-            level.solver.newton.max_iterations = level.solver.newton.max_iterations.max(FAST_MAX_ITERATIONS);
-            // On a slowly loaded drape at long steps the incomplete factor leaves CG tens of
-            // iterations per Newton iteration; the complete factor a few, and it is rebuilt
-            // rarely. A falling cloth's contacts and shifts change from one iteration to the
-            // next, and rebuilding the complete factor that often costs more than the
-            // incomplete factor's extra CG iterations (docs/fast-path.md), at any size.
-            if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
-                level.solver.newton.preconditioner =
-                    if slow { PreconditionerChoice::Cholesky } else { PreconditionerChoice::IncompleteCholesky };
-            }
-        }
-        level.solver.newton.error_share = fast.error_share;
-        // A cloth landing on a prop buckles in most iterations of its landing steps: once
-        // the exact matrix has failed in a step, the rest of the step is solved on the
-        // bounded one instead of trying the exact one first again (docs/fast-path.md).
-        if !slow {
-            level.solver.newton.retry_exact = false;
-        }
-
-    }
-    level
 }
 
 /// The finer levels still to come and the settling of the current one.
@@ -238,9 +141,4 @@ impl Scene {
         let earlier = std::mem::replace(&mut self.rig, next.rig);
         self.rig.continue_history(earlier);
     }
-}
-
-/// Builds the finer levels of `schedule` (coarsest first, already built, excluded).
-pub fn build_pending(config: &SceneConfig, finer: &[f64]) -> Result<Vec<Scene>, SceneError> {
-    finer.iter().map(|&edge| Scene::build_level(config.clone(), Some(edge))).collect()
 }

@@ -13,6 +13,7 @@ pub mod props;
 pub mod rigs;
 pub mod run;
 pub mod strip;
+pub mod plan;
 pub mod swing;
 pub mod validate;
 
@@ -20,7 +21,7 @@ pub use measures::Measures;
 pub use preset::{SceneConfig, SceneKind, load_scene};
 pub use run::{ContactEvents, Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
 
-use crate::sim::contact::{ContactModel, ContactSettings};
+use crate::sim::contact::ContactModel;
 use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -65,28 +66,23 @@ const POOL_STEP_TRIANGLES: usize = 4096;
 
 impl Scene {
     pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
-        if config.scene.kind == SceneKind::Garment {
-            // A garment settles on its own mesh (its panels are sewn and welded once); the
-            // fast path gives it its long steps and Newton's step-sized tolerance there.
-            let edge = (config.solver.path == levels::SolverPath::Fast).then_some(config.mesh.edge_length);
-            return Self::build_level(config, edge);
+        let plan = plan::RunPlan::resolve(&config)?;
+        let mut levels = plan.levels.into_iter();
+        let first = levels.next().expect("a plan has at least one level");
+        let mut scene = Self::build_level(config.clone(), first)?;
+        if plan.design == plan::Design::Settling {
+            // Every finer level is built now, so that a bad mesh is refused before any work.
+            let pending = levels.map(|level| Self::build_level(config.clone(), level)).collect::<Result<_, _>>()?;
+            scene.levels = Some(levels::Levels::new(&scene, pending));
         }
-        match levels::schedule(&config)? {
-            Some(edges) => {
-                let pending = levels::build_pending(&config, &edges[1..])?;
-                let mut scene = Self::build_level(config, Some(edges[0]))?;
-                scene.levels = Some(levels::Levels::new(&scene, pending));
-                Ok(scene)
-            }
-            None => Self::build_level(config, None),
-        }
+        Ok(scene)
     }
 
-    /// The scene on its own mesh, or with `edge_length` instead of `mesh.edge_length` (a
-    /// level of the fast path's coarse-to-fine schedule, which also takes the fast path's
-    /// time step).
-    pub(crate) fn build_level(config: SceneConfig, edge_length: Option<f64>) -> Result<Self, SceneError> {
-        let level_config = levels::level_config(&config, edge_length);
+    /// One level of the scene's plan: `config` is the scene's own settings, kept for a
+    /// later re-plan; the level's are what it is built and stepped with.
+    pub(crate) fn build_level(config: SceneConfig, level: plan::Level) -> Result<Self, SceneError> {
+        let edge_length = level.fast.then_some(level.edge_length);
+        let level_config = level.config;
         let fabric = level_config.material().map_err(ModelError::from)?;
         let props = props::build_props(&level_config.props, level_config.base_dir.as_deref()).map_err(SceneError::Setup)?;
         let options = PhysicsOptions {
@@ -133,7 +129,7 @@ impl Scene {
             }
         }
         if !props.is_empty() || level_config.contact.self_collision {
-            let settings = ContactSettings { relative_motion: level_config.solver.path == levels::SolverPath::Fast, ..level_config.contact };
+            let settings = level_config.contact;
             model.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
         }
         let integrator = level_config.solver.integrator();
@@ -152,7 +148,7 @@ impl Scene {
         }
         self.config.solver.dt = dt;
         self.config.solver.integrator = kind;
-        let mut integrator = levels::level_config(&self.config, self.level_edge).solver.integrator();
+        let mut integrator = plan::level(&self.config, self.level_edge).solver.integrator();
         integrator.contact_stats = self.integrator.contact_stats;
         self.integrator = integrator;
         self.state.clear_history();

@@ -14,7 +14,7 @@
 pub mod rig;
 
 use super::preset::SceneConfig;
-use super::{Scene, SceneError, levels};
+use super::{Scene, SceneError};
 use crate::garment::{self, Garment, form};
 use crate::sim::contact::{ContactModel, ContactSettings, Prop, PropShape};
 use crate::sim::model::PanelSurface;
@@ -117,7 +117,7 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
     let mut welded = Model::from_panels(&welded_surface, &[], fabric, options)?;
     let mut props = super::props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
     props.insert(0, form);
-    let settings = ContactSettings { relative_motion: config.solver.path == levels::SolverPath::Fast, ..config.contact };
+    let settings = config.contact;
     welded.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
     model.contact = Some(ContactModel::new(props.clone(), ContactSettings { self_collision: false, ..settings }).map_err(SceneError::Setup)?);
     let pin_after: Vec<u32> = model.sewing.anchors.iter().map(|a| a.0).collect();
@@ -360,7 +360,7 @@ impl Scene {
         state.v = velocity;
         state.time = self.state.time;
         state.steps = self.state.steps;
-        let mut integrator = levels::level_config(&self.config, self.level_edge).solver.integrator();
+        let mut integrator = super::plan::level(&self.config, self.level_edge).solver.integrator();
         integrator.contact_stats = self.integrator.contact_stats;
         sewing.sewn_at = Some(self.state.time);
         sewing.gap_at_weld = Some(gap);

@@ -1,0 +1,307 @@
+//! The run plan: the step design a scene runs on, resolved once from its settings.
+//!
+//! Everything about *how* a scene is stepped, as opposed to *what* it models, is decided
+//! here and nowhere else: which design the scene takes, its levels (the meshes it settles
+//! on, coarse to fine), and per level the integrator, time step, Newton's limits and
+//! tolerance, the linear solver's preconditioner and the contact penalty. `Scene::build`
+//! calls [`RunPlan::resolve`] once and builds each level from the settings it holds;
+//! `rosette run SCENE --plan` prints it.
+//!
+//! ```text
+//!   exact path ─────────────────────────────── Exact: the scene's own mesh and settings
+//!   fast path ─┬ settles, no props or a ramp ─ Settling: coarse to fine, long steps
+//!              ├ in motion (props, no ramp,
+//!              │  or the swing) ────────────── Motion: own mesh, the step for motion
+//!              ├ a garment ─────────────────── Garment: own mesh, the step for motion
+//!              └ a laboratory rig ──────────── Exact (the loading is the experiment)
+//! ```
+
+use super::levels::SolverPath;
+use super::{SceneConfig, SceneError, SceneKind};
+use crate::sim::PreconditionerChoice;
+use std::fmt::Write as _;
+
+/// Which step design a scene runs on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Design {
+    /// The scene's own mesh and settings from start to end: the exact path, and on the
+    /// fast path the laboratory's rigs, whose loading is the experiment.
+    Exact,
+    /// The fast path's coarse-to-fine settling: each level settles at long steps, then
+    /// hands its cloth to the next finer one; the run ends when the scene's own mesh has
+    /// settled (docs/fast-path.md, items 1–5).
+    Settling,
+    /// A cloth in motion on the fast path (a drop not watched for settling, the swing): the
+    /// scene's own mesh at the step for cloth in motion (docs/fast-path.md, item 6).
+    Motion,
+    /// A garment on the fast path: its own mesh (its panels are sewn and welded once) at
+    /// the step for cloth in motion.
+    Garment,
+}
+
+impl Design {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Exact => "the scene's own mesh and settings throughout",
+            Self::Settling => "coarse to fine: each level settles, then the next finer one",
+            Self::Motion => "cloth in motion: the scene's own mesh at the fast path's step for motion",
+            Self::Garment => "a garment: its own mesh at the fast path's step for motion",
+        }
+    }
+}
+
+/// One level of a run: a mesh and the settings its steps run with.
+#[derive(Debug, Clone)]
+pub struct Level {
+    /// The level's mesh edge, m (the scene's own on the last level).
+    pub edge_length: f64,
+    /// Whether the fast path's settings apply (every design but `Exact`).
+    pub fast: bool,
+    /// The scene's settings as this level runs them: the mesh, solver and contact sections
+    /// resolved; the model's sections as the scene has them.
+    pub config: SceneConfig,
+}
+
+/// How a scene runs: its design and its levels, coarsest first.
+#[derive(Debug, Clone)]
+pub struct RunPlan {
+    pub design: Design,
+    pub levels: Vec<Level>,
+}
+
+impl RunPlan {
+    /// The plan of `config`'s run. Refuses a path the integrator cannot take.
+    pub fn resolve(config: &SceneConfig) -> Result<Self, SceneError> {
+        let solver = &config.solver;
+        let design = design(config);
+        if design != Design::Exact && solver.integrator.is_explicit() {
+            return Err(SceneError::Setup(
+                "solver.path = \"fast\" takes implicit steps, which solver.integrator = \"symplectic-euler\" cannot; \
+                 use solver.integrator = \"implicit-euler\" or solver.path = \"exact\""
+                    .into(),
+            ));
+        }
+        let own = config.mesh.edge_length;
+        let edges = match design {
+            Design::Exact => return Ok(Self { design, levels: vec![Level { edge_length: own, fast: false, config: level(config, None) }] }),
+            Design::Motion | Design::Garment => vec![own],
+            Design::Settling => {
+                let coarsest = coarsest_edge(config).map_err(crate::sim::ModelError::from)?;
+                let mut edges = vec![own];
+                while 2.0 * edges[0] <= coarsest {
+                    edges.insert(0, 2.0 * edges[0]);
+                }
+                edges
+            }
+        };
+        let levels = edges.into_iter().map(|edge| Level { edge_length: edge, fast: true, config: level(config, Some(edge)) }).collect();
+        Ok(Self { design, levels })
+    }
+
+    /// The plan in words, a line per level: what `rosette run --plan` prints.
+    pub fn describe(&self, scene: &SceneConfig) -> String {
+        let mut text = format!(
+            "path {}: {} ({} level{})\n",
+            scene.solver.path.name(),
+            self.design.describe(),
+            self.levels.len(),
+            if self.levels.len() == 1 { "" } else { "s" }
+        );
+        for (i, level) in self.levels.iter().enumerate() {
+            let (c, s, n) = (&level.config, &level.config.solver, &level.config.solver.newton);
+            let mm = |m: f64| format!("{:.3} mm", 1e3 * m);
+            let own = if i + 1 == self.levels.len() { " (the scene's mesh)" } else { "" };
+            let _ = writeln!(text, "level {}: {} edges{own}", i + 1, mm(level.edge_length));
+            let step = if s.dt != scene.solver.dt { format!(" (the scene's {} s)", scene.solver.dt) } else { String::new() };
+            let _ = writeln!(text, "  step: {}, dt {} s{step}, damping {} 1/s{}", s.integrator.name(), s.dt, s.damping, if s.adaptive.is_some() { ", adaptive" } else { "" });
+            let _ = writeln!(
+                text,
+                "  {}: at most {} iterations, tolerance {} of the mean edge{}, preconditioner {}{}, indefinite {}, retry exact {}",
+                n.minimizer.name(),
+                n.max_iterations,
+                n.tolerance,
+                if n.error_share > 0.0 { format!(" or {} of the step's local error", n.error_share) } else { String::new() },
+                key_name(&n.preconditioner),
+                if n.preconditioner == PreconditionerChoice::Auto {
+                    format!(" (the complete factor from {} vertices)", PreconditionerChoice::AUTO_CHOLESKY_VERTICES)
+                } else {
+                    String::new()
+                },
+                key_name(&n.indefinite),
+                n.retry_exact,
+            );
+            if !c.props.is_empty() || c.contact.self_collision {
+                let factor = c.contact.stiffness / scene.contact.stiffness;
+                let _ = writeln!(
+                    text,
+                    "  contact: stiffness {} m/dt²{}, pair list kept by {} motion",
+                    c.contact.stiffness,
+                    if factor != 1.0 { format!(" (the scene's × {factor:.3})") } else { String::new() },
+                    if c.contact.relative_motion { "relative" } else { "absolute" },
+                );
+            }
+        }
+        text
+    }
+}
+
+/// A setting's value as a scene file spells it.
+fn key_name<T: serde::Serialize>(value: &T) -> String {
+    serde_json::to_value(value).ok().and_then(|v| v.as_str().map(str::to_string)).unwrap_or_default()
+}
+
+/// The design `config` runs on.
+fn design(config: &SceneConfig) -> Design {
+    if config.solver.path != SolverPath::Fast {
+        return Design::Exact;
+    }
+    if config.scene.kind == SceneKind::Garment {
+        return Design::Garment;
+    }
+    match (config.scene.settle_speed.is_some(), quasi_static(config)) {
+        (true, _) => Design::Settling,
+        (false, false) => Design::Motion,
+        (false, true) => Design::Exact,
+    }
+}
+
+/// The coarsest edge that still resolves the scene's folds: `solver.fast.coarsest_edge_share`
+/// of the fabric's bending length (B/w)^(1/3), m (the weaker direction's).
+fn coarsest_edge(config: &SceneConfig) -> Result<f64, crate::sim::FabricError> {
+    let fabric = config.material()?;
+    let weight = fabric.weight_per_area(super::GRAVITY);
+    let bending_length = (fabric.bending_warp.min(fabric.bending_weft) / weight).cbrt();
+    Ok(config.solver.fast.coarsest_edge_share * bending_length)
+}
+
+/// Newton's iteration limit on the fast path's long steps.
+const FAST_MAX_ITERATIONS: usize = 80;
+
+/// Whether the scene loads its cloth slowly: no props to land on (except the swing, which
+/// moves freely throughout), or props with gravity ramped up (a lowered specimen).
+/// Otherwise the cloth is dropped onto its props, or swings, and is in motion at every step.
+fn quasi_static(config: &SceneConfig) -> bool {
+    let free_motion = config.scene.kind == SceneKind::Swing;
+    (config.props.is_empty() && !free_motion) || config.scene.gravity_ramp.is_some()
+}
+
+/// The settings of one level: the scene's own for None (the exact design); on a fast-path
+/// level, the scene on a mesh of `edge_length` with the fast path's step, Newton and
+/// contact. Also what a settings change on a running scene re-plans with
+/// (`Scene::set_solver`).
+pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConfig {
+    let mut level = config.clone();
+    let Some(edge) = edge_length else { return level };
+    let fast = &config.solver.fast;
+    level.mesh.edge_length = edge;
+    // The pair list is kept across Newton iterations by the cloth's motion relative to its
+    // common fall (docs/fast-path.md, item 3).
+    level.contact.relative_motion = true;
+    // Long steps follow a quasi-static load through near-equilibria, which holds where
+    // the mesh resolves the folds. On a mesh whose elements are as wide as the folds the
+    // drape depends on the path at the scale of an element, and the scene keeps its step.
+    // A cloth dropped onto a prop takes the shorter `drop_dt` on any mesh (its folds
+    // depend on the fall's path at every step), with the contact penalty's factor raised
+    // with the square of the step so that its stiffness c·m/Δt² stays the scene's: a
+    // vertex arriving at speed v then stops within v·Δt/√c of the same layer as at the
+    // scene's own step.
+    let resolved = coarsest_edge(config).is_ok_and(|coarsest| edge <= coarsest * (1.0 + 1e-9));
+    let slow = quasi_static(config);
+    let long_dt = if slow { resolved.then_some(fast.dt) } else { Some(fast.drop_dt) };
+    if let Some(long_dt) = long_dt.filter(|&d| d > config.solver.dt) {
+        level.solver.dt = long_dt;
+        if !slow {
+            level.contact.stiffness *= (long_dt / config.solver.dt).powi(2);
+        }
+        // The first step after a transfer relaxes, in one long step, what the coarser
+        // mesh could not resolve; Newton gets the iterations that takes.
+        level.solver.newton.max_iterations = level.solver.newton.max_iterations.max(FAST_MAX_ITERATIONS);
+        // On a slowly loaded drape at long steps the incomplete factor leaves CG tens of
+        // iterations per Newton iteration; the complete factor a few, and it is rebuilt
+        // rarely. A falling cloth's contacts and shifts change from one iteration to the
+        // next, and rebuilding the complete factor that often costs more than the
+        // incomplete factor's extra CG iterations (docs/fast-path.md), at any size.
+        if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
+            level.solver.newton.preconditioner = if slow { PreconditionerChoice::Cholesky } else { PreconditionerChoice::IncompleteCholesky };
+        }
+    }
+    level.solver.newton.error_share = fast.error_share;
+    // A cloth landing on a prop buckles in most iterations of its landing steps: once
+    // the exact matrix has failed in a step, the rest of the step is solved on the
+    // bounded one instead of trying the exact one first again (docs/fast-path.md).
+    if !slow {
+        level.solver.newton.retry_exact = false;
+    }
+    level
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load_scene;
+
+    fn plan(preset: &str, overrides: &[&str]) -> (SceneConfig, RunPlan) {
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let (config, _) = load_scene(preset, &overrides).unwrap();
+        let plan = RunPlan::resolve(&config).unwrap();
+        (config, plan)
+    }
+
+    #[test]
+    fn the_exact_path_and_the_laboratory_rigs_run_the_scenes_own_settings() {
+        for (preset, path) in [("cusick-drape", "exact"), ("sphere-drop", "exact"), ("tensile-warp", "fast"), ("euler-buckling", "fast")] {
+            let (config, plan) = plan(preset, &[&format!("solver.path={path}")]);
+            assert_eq!(plan.design, Design::Exact, "{preset} on the {path} path");
+            assert_eq!(plan.levels.len(), 1);
+            let level = &plan.levels[0];
+            assert!(!level.fast);
+            assert_eq!(serde_json::to_value(&level.config).unwrap(), serde_json::to_value(&config).unwrap(), "{preset}: the settings are the scene's");
+        }
+    }
+
+    #[test]
+    fn a_settling_drape_halves_its_edge_from_the_coarsest_that_resolves_its_folds() {
+        let (config, plan) = plan("cusick-drape", &["solver.path=fast", "mesh.edge_length=0.00315"]);
+        assert_eq!(plan.design, Design::Settling);
+        let coarsest = coarsest_edge(&config).unwrap();
+        let edges: Vec<f64> = plan.levels.iter().map(|l| l.edge_length).collect();
+        assert_eq!(*edges.last().unwrap(), 0.00315, "the run ends on the scene's mesh");
+        assert!(edges[0] <= coarsest && 2.0 * edges[0] > coarsest, "{edges:?} against the coarsest {coarsest}");
+        for pair in edges.windows(2) {
+            assert!((pair[0] - 2.0 * pair[1]).abs() < 1e-12, "{edges:?}");
+        }
+        for level in &plan.levels {
+            assert_eq!(level.config.mesh.edge_length, level.edge_length);
+            assert_eq!(level.config.solver.dt, config.solver.fast.dt, "a lowered drape takes the long step on levels that resolve its folds");
+            assert_eq!(level.config.contact.stiffness, config.contact.stiffness, "a lowered drape keeps its contact penalty");
+            assert_eq!(level.config.solver.newton.error_share, config.solver.fast.error_share);
+        }
+    }
+
+    #[test]
+    fn cloth_in_motion_keeps_its_mesh_at_the_step_for_motion_with_the_penalty_rescaled() {
+        let (mut config, _) = load_scene("sphere-drop", &["solver.path=fast".into()]).unwrap();
+        config.scene.settle_speed = None;
+        let dropped = RunPlan::resolve(&config).unwrap();
+        assert_eq!(dropped.design, Design::Motion);
+        assert_eq!(dropped.levels.len(), 1);
+        let level = &dropped.levels[0].config;
+        let ratio = config.solver.fast.drop_dt / config.solver.dt;
+        assert_eq!(level.mesh.edge_length, config.mesh.edge_length);
+        assert_eq!(level.solver.dt, config.solver.fast.drop_dt);
+        assert!((level.contact.stiffness - config.contact.stiffness * ratio * ratio).abs() < 1e-9 * level.contact.stiffness);
+        assert!(level.contact.relative_motion && !level.solver.newton.retry_exact);
+        assert_eq!(level.solver.newton.preconditioner, PreconditionerChoice::IncompleteCholesky);
+        // The swing moves freely with no prop: the same design.
+        let (_, swing) = plan("swing", &["solver.path=fast"]);
+        assert_eq!(swing.design, Design::Motion);
+        assert_eq!(swing.levels[0].config.solver.dt, config.solver.fast.drop_dt);
+    }
+
+    #[test]
+    fn a_fast_path_the_integrator_cannot_take_is_refused_naming_both_keys() {
+        let (config, _) = load_scene("swing", &["solver.path=fast".into(), "solver.integrator=symplectic-euler".into(), "solver.dt=1e-5".into()]).unwrap();
+        let message = RunPlan::resolve(&config).unwrap_err().to_string();
+        assert!(message.contains("solver.path") && message.contains("solver.integrator"), "{message}");
+    }
+}
