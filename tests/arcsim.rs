@@ -413,7 +413,7 @@ fn bad_material_files_exit_2_naming_the_field() {
     std::fs::create_dir_all(&dir).unwrap();
     let out = rosette_cli(&["fabric", "import", dir.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("not a regular file"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("is a folder"), "{}", String::from_utf8_lossy(&out.stderr));
     let big = temp("big.json", &" ".repeat(2 << 20));
     let out = rosette_cli(&["fabric", "import", big.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));

@@ -131,7 +131,7 @@ fn bad_fabrics_and_outputs_are_refused_before_any_run() {
     assert!(!sheet.exists() && !sheet.with_extension("json").exists());
     let out = rosette(&["compare", "silk", "--scene", "cantilever", "--out", sheet.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
-    assert!(text(&out.stderr).contains("not a drape scene"), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("not a drape or garment scene"), "{}", text(&out.stderr));
 }
 
 #[test]

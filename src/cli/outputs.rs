@@ -22,7 +22,7 @@ pub const DRAPE_REFERENCE_CSV: Kind =
     Kind { noun: "a chart's drape reference", signature: Signature::Starts(rosette::chart::data::DRAPE_REFERENCE_HEADER) };
 pub const BENCH_CSV: Kind = Kind { noun: "a benchmark table", signature: Signature::Starts("case,threads,") };
 pub const BENCH_JSON: Kind = Kind { noun: "a benchmark's numbers", signature: Signature::Starts("[\n  {\n    \"case\": ") };
-pub const ARCSIM_FILE: Kind = Kind { noun: "an ARCSim material written by Rosette", signature: Signature::Starts("// ARCSim material of ") };
+pub const ARCSIM_FILE: Kind = Kind { noun: "an ARCSim material", signature: Signature::Starts("// ARCSim material of ") };
 pub const FABRIC_FILE: Kind = Kind { noun: "a fabric file", signature: Signature::SecondLine("# Written by `rosette fabric import") };
 
 /// The files a command read (scenes, fabrics, sheets), with the meshes its scene's props

@@ -148,7 +148,8 @@ impl Plan {
                 input.kind.noun()
             ));
         }
-        if !self.force && !out.kind.recognises(&head(&out.path)) {
+        // An empty file holds nothing to lose (a name made ready with touch or mktemp).
+        if !self.force && metadata.len() > 0 && !out.kind.recognises(&head(&out.path)) {
             return Err(format!(
                 "{shown}: the file exists and is not {} Rosette wrote; give another name, or add --force to replace it",
                 out.kind.noun

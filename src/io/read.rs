@@ -47,7 +47,7 @@ impl FileKind {
             FileKind::Fabric => "fabric file",
             FileKind::Obj => "mesh file (OBJ)",
             FileKind::Csv => "CSV file",
-            FileKind::Arcsim => "ARCSim material (JSON)",
+            FileKind::Arcsim => "material file in ARCSim's JSON format",
         }
     }
 

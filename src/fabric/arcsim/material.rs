@@ -45,7 +45,8 @@ pub struct ArcsimMaterial {
 pub enum ArcsimError {
     #[error("cannot read {path}: {message}")]
     Io { path: String, message: String },
-    #[error("{path}: {message}")]
+    /// The bounded reader's refusal, whose message names the file already.
+    #[error("{message}")]
     NotAMaterial { path: String, message: String },
     #[error("{file}: not valid JSON: {message} (line {line}, column {column})")]
     Syntax { file: String, message: String, line: usize, column: usize },
