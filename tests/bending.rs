@@ -98,7 +98,7 @@ fn arc_rigidity_off_axis_converges_to_b_theta_as_the_edge_layers_shrink() {
 fn cantilever_check(patterns: &[&str], warps: &[f64], fabric: &[&str]) {
     let fabric: Vec<String> = fabric.iter().map(|s| s.to_string()).collect();
     let (base, _) = load_scene("cantilever", &fabric).unwrap();
-    let w = base.fabric.properties.areal_density * rosette::scene::GRAVITY;
+    let w = base.fabric.properties.areal_density * rosette::physics::STANDARD_GRAVITY;
     for &pattern in patterns {
         for &warp in warps {
             let b = rigidity(&base, -warp);
@@ -173,7 +173,7 @@ fn bias_cantilever_follows_the_anticlastic_strip_theory() {
     let (config, _) = load_scene("cantilever", &[]).unwrap();
     let f = config.fabric.to_fabric().unwrap();
     let b45 = config.fabric.properties.bending_bias.expect("the bundled wool has a bias rigidity");
-    let w = f.areal_density * 9.80665;
+    let w = f.areal_density * rosette::physics::STANDARD_GRAVITY;
     let axial = rosette::reference::off_axis_modulus(
         f.tensile_warp.initial_slope(),
         f.tensile_weft.initial_slope(),
@@ -211,7 +211,7 @@ fn bias_cantilever_follows_the_anticlastic_strip_theory() {
 #[test]
 fn cantilever_error_shrinks_on_refinement() {
     let (base, _) = load_scene("cantilever", &[]).unwrap();
-    let w = base.fabric.properties.areal_density * rosette::scene::GRAVITY;
+    let w = base.fabric.properties.areal_density * rosette::physics::STANDARD_GRAVITY;
     let length: f64 = (8.0 * rigidity(&base, 0.0) / w).cbrt();
     let exact = heavy_cantilever(8.0);
     let mut errors = Vec::new();

@@ -7,7 +7,8 @@ use crate::fabric::sheet::Sheets;
 use crate::fabric::units::GF_CM_PER_CM;
 use crate::lab::{self, CantileverTest, Direction, KesTensile, LabRuns, PureBending, ShearTest, TensilePull};
 use crate::scene::preset::{FabricConfig, SCENES};
-use crate::scene::{GRAVITY, Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use crate::physics::{bending_length, weight_per_area};
+use crate::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 use crate::sim::BendingStiffness;
 use std::time::Instant;
 
@@ -234,7 +235,7 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
             }
         })
         .collect();
-    let w = p.areal_density * GRAVITY;
+    let w = weight_per_area(p.areal_density);
     let cantilever = runs
         .cantilever
         .iter()
@@ -243,7 +244,7 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
             strip_width_mm: 1e3 * c.strip_width,
             bending_length_mm: 1e3 * c.bending_length,
             overhang_mm: 1e3 * c.overhang,
-            formula_bending_length_mm: 1e3 * (input_b(c.direction) / w).cbrt(),
+            formula_bending_length_mm: 1e3 * bending_length(input_b(c.direction), w),
             runs: c.runs,
         })
         .collect();
