@@ -4,7 +4,8 @@
 //! with measurements; `render` draws snapshots with wgpu (window and headless); the
 //! `rosette` binary drives scenes from the command line; `fabric` turns laboratory
 //! measurement sheets (KES-F, FAST, cantilever) into fabrics and `lab` runs the standard
-//! tests on them virtually; `reference` holds the analytic
+//! tests on them virtually; `physics` holds gravity and the bending-length relations, once;
+//! `reference` holds the analytic
 //! solutions (elastica, off-axis formulas) the tests and the chart compare against; `chart`
 //! sweeps integrators, time steps and meshes for speed against accuracy; `bench` times
 //! scenes; `io` reads the files a user names and writes every output whole, never over
@@ -18,6 +19,7 @@ pub mod fabric;
 pub mod garment;
 pub mod io;
 pub mod lab;
+pub mod physics;
 pub mod reference;
 pub mod render;
 pub mod scene;

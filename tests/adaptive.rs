@@ -6,7 +6,8 @@ mod common;
 
 use common::reference::heavy_cantilever;
 use glam::DVec3;
-use rosette::scene::{GRAVITY, RunOptions, Scene, load_scene, run_scene};
+use rosette::physics::STANDARD_GRAVITY as GRAVITY;
+use rosette::scene::{RunOptions, Scene, load_scene, run_scene};
 use rosette::sim::{AdaptiveStep, Fabric, Integrator, IntegratorKind, Mesh, Model, Pattern, PhysicsOptions, State};
 
 fn wool() -> Fabric {

@@ -138,7 +138,7 @@ fn friction_follows_coulombs_law_on_an_incline() {
         }
         samples
     };
-    let g = 9.81;
+    let g = rosette::physics::STANDARD_GRAVITY;
     let still = run(20.0);
     let (_, speed) = *still.last().unwrap();
     // Sticking friction is smoothed below 1 mm/s (contact.slip_speed); sliding would reach

@@ -12,7 +12,7 @@ use rosette::scene::SceneConfig;
 
 /// Bending length c = (B/w)^(1/3) with B the mean of warp and weft rigidities.
 fn bending_length(c: &SceneConfig) -> f64 {
-    (0.5 * (c.fabric.properties.bending_warp + c.fabric.properties.bending_weft) / (c.fabric.properties.areal_density * 9.81)).cbrt()
+    (0.5 * (c.fabric.properties.bending_warp + c.fabric.properties.bending_weft) / (c.fabric.properties.areal_density * rosette::physics::STANDARD_GRAVITY)).cbrt()
 }
 
 /// Ranges of drape coefficient measured on real fabrics (docs/references.md §7): limp silks
@@ -80,7 +80,7 @@ fn strip_bound(config: &SceneConfig) -> f64 {
     let b_min = (0..=90)
         .map(|d| bending_rigidity_theta(f.bending_warp, f.bending_weft, mid, (d as f64).to_radians()))
         .fold(f64::INFINITY, f64::min);
-    independent_strip_drape_lower_bound(config.cloth.diameter, 0.18, f.areal_density, b_min, 9.81)
+    independent_strip_drape_lower_bound(config.cloth.diameter, 0.18, f.areal_density, b_min, rosette::physics::STANDARD_GRAVITY)
 }
 
 /// Measured ranges and the bending-length order, on the standard's 30 cm specimen: the

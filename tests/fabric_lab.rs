@@ -83,7 +83,7 @@ fn bias_bending_lengths_read_back_on_the_standard_strip() {
     let loaded: Vec<(&str, LoadedFabric)> = sheets.iter().map(|(n, t)| (*n, parse_fabric(t, n).unwrap())).collect();
     for (name, f) in &loaded {
         assert!(f.warnings.is_empty(), "{name}: {:?}", f.warnings);
-        let plate = f.config.properties.areal_density * 9.80665 * f.sheets.cantilever.as_ref().unwrap().si("c_bias").unwrap().powi(3);
+        let plate = f.config.properties.areal_density * rosette::physics::STANDARD_GRAVITY * f.sheets.cantilever.as_ref().unwrap().si("c_bias").unwrap().powi(3);
         let b45 = f.config.properties.bending_bias.unwrap();
         println!("{name}: bending_bias {b45:.4e} N·m, {:.1} % above the plate reading W·g·c³ = {plate:.4e}", 100.0 * (b45 / plate - 1.0));
     }

@@ -123,7 +123,7 @@ pin = true
 /// times softer for this wool, whose shear modulus is small).
 #[test]
 fn a_hanging_panel_stretches_by_its_weight_over_the_modulus_of_its_cut() {
-    let (length, g) = (0.6, 9.81);
+    let (length, g) = (0.6, rosette::physics::STANDARD_GRAVITY);
     let runs: Vec<(f64, f64)> = std::thread::scope(|s| {
         let handles: Vec<_> = [(90.0, 0.0), (45.0, 45f64.to_radians())]
             .into_iter()
@@ -317,7 +317,7 @@ fn the_bias_cut_gores_stretch_by_what_e45_predicts() {
         modulus_at(45f64.to_radians(), initial_slope(&f.tensile_warp), initial_slope(&f.tensile_weft), f.shear_modulus, f.poisson_warp),
     );
     let (length, hip) = (0.5613, 0.206);
-    let weight = f.areal_density * 9.81;
+    let weight = f.areal_density * rosette::physics::STANDARD_GRAVITY;
     let compliance = 1.0 / e45 - 1.0 / e0;
     let (low, high) = (weight * gore_load_integral(0.176, 0.40, length, hip) * compliance, weight * gore_load_integral(0.176, 0.40, length, 0.0) * compliance);
     let measured = runs[1].0 - runs[0].0;

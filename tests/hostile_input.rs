@@ -365,8 +365,10 @@ fn a_run_past_its_wall_time_bound_stops_with_exit_6_and_keeps_its_metrics() {
 
 /// A mesh far above what the run may hold is refused before it is built, with the estimate
 /// and an edge length that fits. The run is given 4 GiB of address space (`ulimit -v`), so
-/// that the test asserts the same on every machine, whatever its free memory; the estimate
-/// for this mesh is about 40 GB.
+/// that the test asserts the same on every machine, whatever its free memory: the refusal
+/// must quote at most that figure as available, which shows the limit was read (a machine
+/// where no figure is known would refuse nothing and fail here). The estimate for this mesh
+/// is about 40 GB.
 #[test]
 fn a_mesh_too_large_for_memory_is_refused_before_it_is_built() {
     let (vertices, edge) = (1_500_000usize, 2.6e-4);
@@ -383,6 +385,13 @@ fn a_mesh_too_large_for_memory_is_refused_before_it_is_built() {
     for word in ["mesh.edge_length", "GB", "available"] {
         assert!(stderr.contains(word), "the message should name '{word}': {stderr}");
     }
+    let quoted: f64 = stderr
+        .split(" GB available")
+        .next()
+        .and_then(|head| head.rsplit(' ').next())
+        .and_then(|figure| figure.parse().ok())
+        .unwrap_or_else(|| panic!("the message should quote the memory available: {stderr}"));
+    assert!(quoted <= 4.3, "the 4 GiB limit should bound the {quoted} GB quoted as available: {stderr}");
 }
 
 #[test]

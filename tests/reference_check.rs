@@ -626,7 +626,7 @@ fn simple_shear_principal_stress_of_fabric_is_steeper_than_45_degrees() {
 /// Paper geometry: 36 cm specimen on an 18 cm support disk (m).
 const SPECIMEN_DIAMETER: f64 = 0.36;
 const SUPPORT_DIAMETER: f64 = 0.18;
-const STANDARD_GRAVITY: f64 = 9.81;
+use rosette::physics::STANDARD_GRAVITY;
 
 #[test]
 fn cusick_drape_coefficient_spans_flat_to_hanging() {

@@ -6,8 +6,9 @@ use crate::fabric::import::{Import, KES_FM};
 use crate::fabric::sheet::Sheets;
 use crate::fabric::units::GF_CM_PER_CM;
 use crate::lab::{self, CantileverTest, Direction, KesTensile, LabRuns, PureBending, ShearTest, TensilePull};
+use crate::physics::{bending_length, weight_per_area};
 use crate::scene::preset::{FabricConfig, SCENES};
-use crate::scene::{GRAVITY, Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use crate::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 use crate::sim::BendingStiffness;
 use std::time::Instant;
 
@@ -146,6 +147,48 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
     let material = fabric.to_fabric().map_err(|e| CardError::BadInput(e.to_string()))?;
     let stiffness = BendingStiffness::new(&material).map_err(|e| CardError::BadInput(e.to_string()))?;
     let drape = drape_config(DRAPE_SCENE, fabric)?;
+    let Results { runs, pull, scene, metrics, times } = run_suite(fabric, &drape, progress)?;
+    let input_b = |d: Direction| stiffness.rigidity_at(-d.warp_angle_deg().to_radians());
+    let p = &fabric.properties;
+    let name = if fabric.name.is_empty() { fabric.preset.clone().unwrap_or_else(|| source.to_string()) } else { fabric.name.clone() };
+    let card = Card {
+        fabric: FabricInfo {
+            name,
+            description: fabric.description.clone(),
+            source: source.into(),
+            areal_density_g_per_m2: 1e3 * p.areal_density,
+            thickness_mm: 1e3 * p.thickness,
+            poisson_warp: p.poisson_warp,
+        },
+        tensile: tensile_section(fabric, &runs, &pull),
+        pure_bending: bending_section(&runs, input_b),
+        cantilever: cantilever_section(fabric, &runs, input_b),
+        shear: shear_section(fabric, &runs),
+        drape: drape_numbers(&scene, &metrics)?,
+        sheet_readback: readback_section(fabric, sheets, runs)?,
+        cost: Cost {
+            cpu_seconds: cpu.elapsed().as_secs_f64(),
+            wall_seconds: wall.elapsed().as_secs_f64(),
+            threads: worker_threads(),
+            tests: times,
+        },
+    };
+    Ok(CardRun { card, drape: scene })
+}
+
+/// What the suite's jobs gave, sorted by test.
+struct Results {
+    runs: LabRuns,
+    pull: TensilePull,
+    scene: Scene,
+    metrics: Metrics,
+    /// Each job's label and wall time, s.
+    times: Vec<(String, f64)>,
+}
+
+/// Runs every test of the suite as one job on rayon's pool, the drape first (it is the
+/// longest); the first error, or the cancellation, ends the card.
+fn run_suite(fabric: &FabricConfig, drape: &SceneConfig, progress: &Progress) -> Result<Results, CardError> {
     let mut jobs = vec![Job::Drape];
     jobs.extend(Direction::ALL.map(Job::Cantilever));
     jobs.push(Job::Shear);
@@ -160,7 +203,7 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
         let label = job.label();
         progress.start(&label);
         let started = Instant::now();
-        let outcome = run_job(job, fabric, &drape, progress);
+        let outcome = run_job(job, fabric, drape, progress);
         progress.finish(&label);
         Some((outcome, started.elapsed().as_secs_f64()))
     });
@@ -182,9 +225,13 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
         }
     }
     let (scene, metrics) = drape_run.expect("the drape is a job");
-    let pull = pull.expect("the bias pull is a job");
+    Ok(Results { runs, pull: pull.expect("the bias pull is a job"), scene, metrics, times })
+}
+
+/// The KES pulls along the warp and the weft against the input curves, and the bias pull
+/// against the off-axis modulus of eq. 1.
+fn tensile_section(fabric: &FabricConfig, runs: &LabRuns, pull: &TensilePull) -> Vec<Tensile> {
     let p = &fabric.properties;
-    let input_b = |d: Direction| stiffness.rigidity_at(-d.warp_angle_deg().to_radians());
     let mut tensile = Vec::new();
     for (d, input) in [(Direction::Warp, &p.tensile_warp), (Direction::Weft, &p.tensile_weft)] {
         let t = &runs.tensile[&d];
@@ -217,7 +264,12 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
         e45_formula_n_per_m: Some(e45),
         ..Tensile::default()
     });
-    let pure_bending = Direction::ALL
+    tensile
+}
+
+/// Pure bending in each direction against eq. 3's B_θ of the input (`input_b`, N·m).
+fn bending_section(runs: &LabRuns, input_b: impl Fn(Direction) -> f64) -> Vec<Bending> {
+    Direction::ALL
         .iter()
         .map(|&d| {
             let b = &runs.bending[&d];
@@ -233,70 +285,54 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
                 ),
             }
         })
-        .collect();
-    let w = p.areal_density * GRAVITY;
-    let cantilever = runs
-        .cantilever
+        .collect()
+}
+
+/// The cantilever's bending lengths against the standard's c = (B/w)^⅓ of the input.
+fn cantilever_section(fabric: &FabricConfig, runs: &LabRuns, input_b: impl Fn(Direction) -> f64) -> Vec<Cantilever> {
+    let w = weight_per_area(fabric.properties.areal_density);
+    runs.cantilever
         .iter()
         .map(|c| Cantilever {
             direction: c.direction.name().into(),
             strip_width_mm: 1e3 * c.strip_width,
             bending_length_mm: 1e3 * c.bending_length,
             overhang_mm: 1e3 * c.overhang,
-            formula_bending_length_mm: 1e3 * (input_b(c.direction) / w).cbrt(),
+            formula_bending_length_mm: 1e3 * bending_length(input_b(c.direction), w),
             runs: c.runs,
         })
-        .collect();
+        .collect()
+}
+
+/// The KES shear against the input's shear modulus.
+fn shear_section(fabric: &FabricConfig, runs: &LabRuns) -> Shear {
     let s = runs.shear.as_ref().expect("the shear is a job");
-    let shear = Shear {
+    Shear {
         modulus_n_per_m: s.modulus,
         g_gf_per_cm_deg: s.kes(),
-        input_modulus_n_per_m: p.shear_modulus,
+        input_modulus_n_per_m: fabric.properties.shear_modulus,
         curve: Curve::new("shear angle (°)", "force per grip length (N/m)", thin(&s.curve, CURVE_POINTS)),
-    };
-    let drape = drape_numbers(&scene, &metrics)?;
-    let sheet_readback = match sheets {
-        Some((sheets, import)) if !sheets.is_empty() => lab::readback_with(sheets, import, fabric, runs)?
-            .properties
-            .iter()
-            .map(|q| SheetValue {
-                field: q.field.clone(),
-                unit: q.unit.into(),
-                sheet: q.sheet,
-                measured: q.measured,
-                error_percent: 100.0 * q.error(),
-                tolerance_percent: 100.0 * q.tolerance,
-                test: q.test.into(),
-                passes: q.passes(),
-                held: q.held(),
-            })
-            .collect(),
-        _ => Vec::new(),
-    };
-    let name = if fabric.name.is_empty() { fabric.preset.clone().unwrap_or_else(|| source.to_string()) } else { fabric.name.clone() };
-    let card = Card {
-        fabric: FabricInfo {
-            name,
-            description: fabric.description.clone(),
-            source: source.into(),
-            areal_density_g_per_m2: 1e3 * p.areal_density,
-            thickness_mm: 1e3 * p.thickness,
-            poisson_warp: p.poisson_warp,
-        },
-        tensile,
-        pure_bending,
-        cantilever,
-        shear,
-        drape,
-        sheet_readback,
-        cost: Cost {
-            cpu_seconds: cpu.elapsed().as_secs_f64(),
-            wall_seconds: wall.elapsed().as_secs_f64(),
-            threads: worker_threads(),
-            tests: times,
-        },
-    };
-    Ok(CardRun { card, drape: scene })
+    }
+}
+
+/// The sheets' values read back from the virtual tests (none without sheets).
+fn readback_section(fabric: &FabricConfig, sheets: Option<(&Sheets, &Import)>, runs: LabRuns) -> Result<Vec<SheetValue>, CardError> {
+    let Some((sheets, import)) = sheets.filter(|(sheets, _)| !sheets.is_empty()) else { return Ok(Vec::new()) };
+    Ok(lab::readback_with(sheets, import, fabric, runs)?
+        .properties
+        .iter()
+        .map(|q| SheetValue {
+            field: q.field.clone(),
+            unit: q.unit.into(),
+            sheet: q.sheet,
+            measured: q.measured,
+            error_percent: 100.0 * q.error(),
+            tolerance_percent: 100.0 * q.tolerance,
+            test: q.test.into(),
+            passes: q.passes(),
+            held: q.held(),
+        })
+        .collect())
 }
 
 /// Threads the tests run on: one per core.

@@ -33,7 +33,8 @@
 //! 41.5° overhang is twice the measured bias bending length. docs/fabric-sheets.md shows
 //! how far it moves B₄₅ (5–15 %) and how closely the simulated strip follows the theory.
 
-use super::units::STANDARD_GRAVITY;
+use crate::physics::{bending_length, rigidity_for_bending_length, weight_per_area};
+use crate::sim::BendingStiffness;
 use std::f64::consts::FRAC_PI_2;
 use thiserror::Error;
 
@@ -72,13 +73,11 @@ pub enum BiasError {
 }
 
 /// The plate stiffnesses of a strip cut at 45°, for a model `bending_bias` of `b45`:
-/// (D′₁₁, D′₁₂, D′₂₂) in N·m, following [`crate::sim::BendingStiffness`]'s split of
-/// eq. 3's middle term (the Poisson part ν·B_x where the term allows it, the rest twist).
+/// (D′₁₁, D′₁₂, D′₂₂) in N·m, with the model's split of eq. 3's middle term
+/// ([`BendingStiffness::with_bias_rigidity`]).
 pub fn rotated_45(strip: &BiasStrip, b45: f64) -> (f64, f64, f64) {
     let (bx, by) = (strip.bending_warp, strip.bending_weft);
-    let middle = 4.0 * b45 - bx - by;
-    let d12 = (strip.poisson_warp * bx).min(0.25 * middle);
-    let d66 = 0.25 * (middle - 2.0 * d12);
+    let BendingStiffness { d12, d66, .. } = BendingStiffness::with_bias_rigidity(bx, by, strip.poisson_warp, b45);
     // Rotating D by 45°: D′₁₁ = D′₂₂ = (D₁₁ + D₂₂ + 2D₁₂ + 4D₆₆)/4 = B₄₅ and
     // D′₁₂ = (D₁₁ + D₂₂ − 4D₆₆)/4 + D₁₂/2.
     (b45, 0.25 * (bx + by - 4.0 * d66) + 0.5 * d12, b45)
@@ -202,10 +201,10 @@ pub fn chord_angle(law: &StripLaw, w: f64, length: f64) -> f64 {
 /// model's `bending_bias` = `b45`: half the overhang whose chord makes 41.5°.
 pub fn strip_bending_length(strip: &BiasStrip, b45: f64) -> f64 {
     let law = StripLaw::new(strip, b45);
-    let w = strip.areal_density * STANDARD_GRAVITY;
+    let w = weight_per_area(strip.areal_density);
     let target = STANDARD_CHORD_ANGLE_DEG.to_radians();
     // The chord angle grows with the overhang; bracket, then bisect on ln L.
-    let plate = (b45 / w).cbrt();
+    let plate = bending_length(b45, w);
     let (mut low, mut high) = (plate, 2.0 * plate);
     while chord_angle(&law, w, low) > target {
         low *= 0.7;
@@ -223,7 +222,7 @@ pub fn strip_bending_length(strip: &BiasStrip, b45: f64) -> f64 {
 /// The model's `bending_bias` (the plate's B₄₅, N·m) for which the strip reproduces a
 /// measured bias bending length `c` (m): its overhang 2c makes the standard's 41.5°.
 pub fn plate_rigidity_for_bending_length(strip: &BiasStrip, c: f64) -> Result<f64, BiasError> {
-    let w = strip.areal_density * STANDARD_GRAVITY;
+    let w = weight_per_area(strip.areal_density);
     let (length, target) = (2.0 * c, STANDARD_CHORD_ANGLE_DEG.to_radians());
     // More rigidity, less droop. Eq. 3's middle term must stay positive (material.rs),
     // so B₄₅ > (B_x + B_y)/4.
@@ -239,7 +238,7 @@ pub fn plate_rigidity_for_bending_length(strip: &BiasStrip, c: f64) -> Result<f6
     if droop(softest) < target {
         return Err(BiasError::TooShort { measured_mm: c * 1e3, shortest_mm: strip_bending_length(strip, softest) * 1e3 });
     }
-    let mut high = (w * c.powi(3)).max(softest * 1.01);
+    let mut high = rigidity_for_bending_length(c, w).max(softest * 1.01);
     while droop(high) > target {
         high *= 2.0;
         if high > ceiling {
@@ -258,7 +257,7 @@ pub fn plate_rigidity_for_bending_length(strip: &BiasStrip, c: f64) -> Result<f6
 mod tests {
     use super::*;
     use crate::reference::heavy_cantilever;
-    use crate::sim::{BendingStiffness, Fabric, PiecewiseLinear};
+    use crate::sim::{Fabric, PiecewiseLinear};
 
     fn wool(width: f64) -> BiasStrip {
         BiasStrip {
@@ -313,7 +312,7 @@ mod tests {
         strip.poisson_warp = 0.0;
         let b45 = 0.25 * (9e-6 + 7e-6) * 2.0; // 4D₆₆ = B_x + B_y makes D′₁₂ = 0.
         let law = StripLaw::new(&strip, b45);
-        let w = 0.137 * STANDARD_GRAVITY;
+        let w = weight_per_area(0.137);
         for lambda in [2.0, 8.0, 20.0] {
             let length: f64 = (lambda * b45 / w).cbrt();
             let exact = heavy_cantilever(lambda).chord_angle_rad;
@@ -324,8 +323,8 @@ mod tests {
     #[test]
     fn bias_mapping_inverts_the_strip_and_relaxation_grows_as_the_strip_narrows() {
         let b45 = 5.6e-6;
-        let w = 0.137 * STANDARD_GRAVITY;
-        let plate = (b45 / w).cbrt();
+        let w = weight_per_area(0.137);
+        let plate = bending_length(b45, w);
         let mut last = 0.0;
         for width in [0.008, 0.025, 0.1] {
             let strip = wool(width);

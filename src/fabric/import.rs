@@ -9,7 +9,8 @@
 use super::bias::{BiasStrip, STANDARD_STRIP_WIDTH, plate_rigidity_for_bending_length};
 use super::sheet::{Section, SheetError, SheetKind, Sheets};
 use super::tensile::{fast_curve, kes_curve};
-use super::units::{GF_PER_CM, STANDARD_GRAVITY};
+use super::units::GF_PER_CM;
+use crate::physics::{rigidity_for_bending_length, weight_per_area};
 use crate::sim::PiecewiseLinear;
 
 /// Bulk density behind a missing thickness, kg/m³: woven apparel fabrics lie near
@@ -183,7 +184,7 @@ impl Deriver<'_> {
             None => (rho, "the fabric's mass per area".to_string()),
         };
         Candidate {
-            value: w * STANDARD_GRAVITY * c.powi(3),
+            value: rigidity_for_bending_length(c, weight_per_area(w)),
             source: format!("{} with {w_text}: B = W·g·c³", section.quote(length_field)),
         }
     }
@@ -484,7 +485,7 @@ impl Deriver<'_> {
             fields: cant.quote(&field),
             message: e.to_string(),
         })?;
-        let plate = strip.areal_density * STANDARD_GRAVITY * c.powi(3);
+        let plate = rigidity_for_bending_length(c, weight_per_area(strip.areal_density));
         let width_text = if cant.si("strip_width").is_some() { cant.quote("strip_width") } else { "the standard's 25 mm strip".into() };
         let source = format!(
             "{} on {width_text}: the plate rigidity whose free strip reads it (W·g·c³ = {:.3} µN·m would ignore the \

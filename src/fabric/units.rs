@@ -13,8 +13,7 @@
 
 use std::f64::consts::PI;
 
-/// Standard gravity, m/s²: the gram-force's definition (3rd CGPM, 1901).
-pub const STANDARD_GRAVITY: f64 = 9.80665;
+// The gram-force is 1 g under standard gravity, [`crate::physics::STANDARD_GRAVITY`].
 // The factors are written as the decimals they are (the nearest f64), not computed:
 // 9.80665e-3 / 1e-2 in floating point is one bit off 0.980665.
 
@@ -166,6 +165,7 @@ pub fn case_variant(quantity: Quantity, unit: &str) -> Option<&'static str> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::physics::STANDARD_GRAVITY;
 
     #[test]
     fn kes_factors_are_the_exact_gram_force_ones() {

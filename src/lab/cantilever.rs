@@ -2,7 +2,7 @@
 
 use super::{Direction, LabError, measure, run, scene_config};
 use crate::fabric::bias::STANDARD_CHORD_ANGLE_DEG;
-use crate::scene::GRAVITY;
+use crate::physics::{bending_length, weight_per_area};
 use crate::scene::preset::FabricConfig;
 
 /// What the virtual cantilever test reports.
@@ -50,7 +50,8 @@ pub fn cantilever_bending_length(fabric: &FabricConfig, direction: Direction, st
     let guess = {
         let f = fabric.to_fabric().map_err(|e| LabError::Setup { test: TEST, message: e.to_string() })?;
         let b = crate::sim::BendingStiffness::new(&f).map_err(|e| LabError::Setup { test: TEST, message: e.to_string() })?;
-        2.0 * (b.rigidity_at(-direction.warp_angle_deg().to_radians()) / (fabric.properties.areal_density * GRAVITY)).cbrt()
+        let rigidity = b.rigidity_at(-direction.warp_angle_deg().to_radians());
+        2.0 * bending_length(rigidity, weight_per_area(fabric.properties.areal_density))
     };
     let (mut x0, mut x1) = (guess.ln(), guess.ln() + 0.05);
     let (mut f0, mut f1) = (chord(x0.exp())? - target, chord(x1.exp())? - target);

@@ -1,8 +1,8 @@
 //! Independent physics reference solutions for Rosette's validation tests and charts.
 //!
 //! Everything here is textbook mechanics computed from scratch in `f64` with nothing but
-//! `std`, so that a test compares the simulator against physics rather than against
-//! itself. The sources, formulas and check values are in `docs/references.md` (§1, §4, §5,
+//! `std` and the definitions in [`crate::physics`] (λ = w·L³/B), so that a test compares
+//! the simulator against physics rather than against itself. The sources, formulas and check values are in `docs/references.md` (§1, §4, §5,
 //! §6 and §7).
 //!
 //! Units: SI, per unit width as textile laboratories report fabric properties. Tensile
@@ -14,6 +14,7 @@ mod chain;
 
 pub use chain::{J0_FIRST_ZERO, bessel_j0, hanging_chain_mode, hanging_chain_period};
 
+use crate::physics::cantilever_lambda;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 // ---------------------------------------------------------------------------------------
@@ -671,8 +672,7 @@ pub fn independent_strip_drape_lower_bound(
     g: f64,
 ) -> f64 {
     let overhang = 0.5 * (specimen_diameter - support_diameter);
-    let weight_per_area = areal_density * g;
-    let lambda = weight_per_area * overhang.powi(3) / bending_rigidity;
+    let lambda = cantilever_lambda(areal_density * g, overhang, bending_rigidity);
     let reach = heavy_cantilever(lambda).tip_reach_over_l * overhang;
     let shadow_radius = 0.5 * support_diameter + reach;
     cusick_drape_coefficient(

@@ -123,188 +123,217 @@ pub struct Renderer {
     shadow: bool,
 }
 
+/// What every pipeline draws into: the shared layout, the colour format and the samples.
+struct Target<'a> {
+    layout: &'a wgpu::PipelineLayout,
+    color_format: wgpu::TextureFormat,
+    multisample: wgpu::MultisampleState,
+}
+
+/// The one bind group's layout: the globals (0), the weave texture and its sampler (1, 2),
+/// the colour scales and theirs (3, 4) and the font atlas (5).
+fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+    let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    let sampler_entry = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("rosette globals and textures"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Globals>() as u64),
+                },
+                count: None,
+            },
+            texture_entry(1),
+            sampler_entry(2),
+            texture_entry(3),
+            sampler_entry(4),
+            texture_entry(5),
+        ],
+    })
+}
+
+fn depth_state(write: bool, compare: wgpu::CompareFunction) -> Option<wgpu::DepthStencilState> {
+    Some(wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(write),
+        depth_compare: Some(compare),
+        stencil: wgpu::StencilState::default(),
+        bias: wgpu::DepthBiasState::default(),
+    })
+}
+
+/// The cloth, prop and shadow pipelines of `shaders/scene.wgsl`.
+fn scene_pipelines(device: &wgpu::Device, target: &Target) -> [wgpu::RenderPipeline; 3] {
+    let scene_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("rosette scene shader"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/scene.wgsl").into()),
+    });
+    let vertex_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32];
+    let vertex_layout = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &vertex_attributes,
+    };
+    let scene_pipeline = |label: &str, vertex: &str, fragment: &str, blend: Option<wgpu::BlendState>, write_depth: bool| {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(target.layout),
+            vertex: wgpu::VertexState {
+                module: &scene_shader,
+                entry_point: Some(vertex),
+                compilation_options: Default::default(),
+                buffers: &[Some(vertex_layout.clone())],
+            },
+            // Cloth is two-sided; props are drawn from both sides too, so a mesh with
+            // inconsistent winding still shows.
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: depth_state(write_depth, wgpu::CompareFunction::Less),
+            multisample: target.multisample,
+            fragment: Some(wgpu::FragmentState {
+                module: &scene_shader,
+                entry_point: Some(fragment),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format: target.color_format, blend, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    let cloth_pipeline = scene_pipeline("rosette cloth", "vs_main", "fs_cloth", None, true);
+    let prop_pipeline = scene_pipeline("rosette props", "vs_main", "fs_prop", None, true);
+    // Min blending: where shadow copies overlap, the darkest wins instead of stacking.
+    let min = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Min };
+    let shadow_pipeline = scene_pipeline("rosette shadow", "vs_shadow", "fs_shadow", Some(wgpu::BlendState { color: min, alpha: min }), false);
+    [cloth_pipeline, prop_pipeline, shadow_pipeline]
+}
+
+/// The screen-space overlay's pipeline (`shaders/overlay.wgsl`): legends and labels,
+/// alpha-blended over the scene.
+fn overlay_pipeline(device: &wgpu::Device, target: &Target) -> wgpu::RenderPipeline {
+    let overlay_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("rosette overlay shader"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/overlay.wgsl").into()),
+    });
+    let overlay_attributes = wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2, 2 => Float32x4, 3 => Float32];
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("rosette overlay"),
+        layout: Some(target.layout),
+        vertex: wgpu::VertexState {
+            module: &overlay_shader,
+            entry_point: Some("vs_overlay"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<OverlayVertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &overlay_attributes,
+            })],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: depth_state(false, wgpu::CompareFunction::Always),
+        multisample: target.multisample,
+        fragment: Some(wgpu::FragmentState {
+            module: &overlay_shader,
+            entry_point: Some("fs_overlay"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: target.color_format,
+                blend: Some(wgpu::BlendState::ALPHA_BLENDING),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The bind group of [`bind_group_layout`]: `globals`, and the weave, colour-scale and font
+/// textures uploaded through `queue` with their samplers.
+fn bind_group(device: &wgpu::Device, queue: &wgpu::Queue, layout: &wgpu::BindGroupLayout, globals: &wgpu::Buffer) -> wgpu::BindGroup {
+    let weave = weave_texture(device, queue);
+    let gradient = device.create_texture_with_data(
+        queue,
+        &texture_descriptor("rosette colour scales", [GRADIENT_TEXELS, GRADIENT_ROWS], 1, wgpu::TextureFormat::Rgba8UnormSrgb),
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &legend::gradient_texels(),
+    );
+    let (font_w, font_h, font_texels) = font::atlas();
+    let font = device.create_texture_with_data(
+        queue,
+        &texture_descriptor("rosette font", [font_w, font_h], 1, wgpu::TextureFormat::R8Unorm),
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &font_texels,
+    );
+    let weave_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("rosette weave sampler"),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    });
+    let gradient_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("rosette gradient sampler"),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    });
+    let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+    let (weave_view, gradient_view, font_view) = (view(&weave), view(&gradient), view(&font));
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("rosette bind group"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&weave_view) },
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&weave_sampler) },
+            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&gradient_view) },
+            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&gradient_sampler) },
+            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&font_view) },
+        ],
+    })
+}
+
 impl Renderer {
     /// Pipelines for a `color_format` target drawn at `sample_count` samples per pixel
     /// (1, or 4 where the adapter supports it for the format and [`DEPTH_FORMAT`]).
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, color_format: wgpu::TextureFormat, sample_count: u32) -> Self {
-        let scene_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("rosette scene shader"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/scene.wgsl").into()),
-        });
-        let overlay_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("rosette overlay shader"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/overlay.wgsl").into()),
-        });
-        let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let sampler_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-            count: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("rosette globals and textures"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Globals>() as u64),
-                    },
-                    count: None,
-                },
-                texture_entry(1),
-                sampler_entry(2),
-                texture_entry(3),
-                sampler_entry(4),
-                texture_entry(5),
-            ],
-        });
+        let layout = bind_group_layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("rosette pipeline layout"),
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-
-        let vertex_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32];
-        let vertex_layout = wgpu::VertexBufferLayout {
-            array_stride: std::mem::size_of::<Vertex>() as u64,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &vertex_attributes,
-        };
-        let multisample = wgpu::MultisampleState { count: sample_count, ..Default::default() };
-        let depth = |write: bool, compare: wgpu::CompareFunction| {
-            Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(write),
-                depth_compare: Some(compare),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            })
-        };
-        let scene_pipeline = |label: &str, vertex: &str, fragment: &str, blend: Option<wgpu::BlendState>, write_depth: bool| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &scene_shader,
-                    entry_point: Some(vertex),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(vertex_layout.clone())],
-                },
-                // Cloth is two-sided; props are drawn from both sides too, so a mesh with
-                // inconsistent winding still shows.
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                depth_stencil: depth(write_depth, wgpu::CompareFunction::Less),
-                multisample,
-                fragment: Some(wgpu::FragmentState {
-                    module: &scene_shader,
-                    entry_point: Some(fragment),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState { format: color_format, blend, write_mask: wgpu::ColorWrites::ALL })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let cloth_pipeline = scene_pipeline("rosette cloth", "vs_main", "fs_cloth", None, true);
-        let prop_pipeline = scene_pipeline("rosette props", "vs_main", "fs_prop", None, true);
-        // Min blending: where shadow copies overlap, the darkest wins instead of stacking.
-        let min = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Min };
-        let shadow_pipeline = scene_pipeline("rosette shadow", "vs_shadow", "fs_shadow", Some(wgpu::BlendState { color: min, alpha: min }), false);
-
-        let overlay_attributes = wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2, 2 => Float32x4, 3 => Float32];
-        let overlay_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("rosette overlay"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &overlay_shader,
-                entry_point: Some("vs_overlay"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<OverlayVertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &overlay_attributes,
-                })],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: depth(false, wgpu::CompareFunction::Always),
-            multisample,
-            fragment: Some(wgpu::FragmentState {
-                module: &overlay_shader,
-                entry_point: Some("fs_overlay"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: color_format,
-                    blend: Some(wgpu::BlendState::ALPHA_BLENDING),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-
+        let target = Target { layout: &pipeline_layout, color_format, multisample: wgpu::MultisampleState { count: sample_count, ..Default::default() } };
+        let [cloth_pipeline, prop_pipeline, shadow_pipeline] = scene_pipelines(device, &target);
+        let overlay_pipeline = overlay_pipeline(device, &target);
         let globals = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("rosette globals"),
             size: std::mem::size_of::<Globals>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let weave = weave_texture(device, queue);
-        let gradient = device.create_texture_with_data(
-            queue,
-            &texture_descriptor("rosette colour scales", [GRADIENT_TEXELS, GRADIENT_ROWS], 1, wgpu::TextureFormat::Rgba8UnormSrgb),
-            wgpu::util::TextureDataOrder::LayerMajor,
-            &legend::gradient_texels(),
-        );
-        let (font_w, font_h, font_texels) = font::atlas();
-        let font = device.create_texture_with_data(
-            queue,
-            &texture_descriptor("rosette font", [font_w, font_h], 1, wgpu::TextureFormat::R8Unorm),
-            wgpu::util::TextureDataOrder::LayerMajor,
-            &font_texels,
-        );
-        let weave_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("rosette weave sampler"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
-        let gradient_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("rosette gradient sampler"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
-        let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
-        let (weave_view, gradient_view, font_view) = (view(&weave), view(&gradient), view(&font));
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("rosette bind group"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&weave_view) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&weave_sampler) },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&gradient_view) },
-                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&gradient_sampler) },
-                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&font_view) },
-            ],
-        });
+        let bind_group = bind_group(device, queue, &layout, &globals);
         Self {
             color_format,
             sample_count,

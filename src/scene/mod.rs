@@ -56,8 +56,9 @@ pub struct Scene {
     pub garment: Option<garment::Sewing>,
 }
 
-/// Standard gravity, m/s².
-pub const GRAVITY: f64 = 9.81;
+/// Standard gravity, m/s²: `scene`'s name for [`crate::physics::STANDARD_GRAVITY`], kept
+/// for the modules that still import it by this name.
+pub use crate::physics::STANDARD_GRAVITY as GRAVITY;
 
 /// From this many triangles a step runs on rayon's pool (`Scene::step`): the size from
 /// which the model's, the contact's and the matrices' loops run in parallel (4 096

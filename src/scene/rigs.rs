@@ -4,6 +4,7 @@ use super::measures::{ArcMeasures, CantileverMeasures, DrapeMeasures, EulerMeasu
 use super::preset::ShearKinematics;
 use super::strip::{Columns, count_half_waves, fit_circle_radius, group_force, vertices_where};
 use super::{SceneConfig, SceneError, SceneKind, drape};
+use crate::physics::{STANDARD_GRAVITY, bending_length, cantilever_lambda, weight_per_area};
 use crate::sim::{Model, Motion, State};
 use glam::{DVec2, DVec3};
 
@@ -202,7 +203,7 @@ impl Rig {
                 Rig::Euler(Euler { left, right, columns, width, length, history: Vec::new(), speed })
             }
             SceneKind::Garment => return Err(SceneError::Setup("garment scenes build their own rig (scene::garment)".into())),
-            SceneKind::Swing => Rig::Swing(super::swing::Swing::attach(config, model, x, super::GRAVITY)?),
+            SceneKind::Swing => Rig::Swing(super::swing::Swing::attach(config, model, x, STANDARD_GRAVITY)?),
             SceneKind::ShearBuckling => {
                 let clamped = vertices_where(&rest, |p| p.y < ON_EDGE);
                 let moving = vertices_where(&rest, |p| p.y > width - ON_EDGE);
@@ -302,15 +303,15 @@ impl Rig {
                 let (tip, before) = (line[n - 1], line[n - 2]);
                 let drop = -tip.z;
                 let tangent = tip - before;
-                let weight = model.mass.iter().sum::<f64>() / model.vertex_area.iter().sum::<f64>() * super::GRAVITY;
+                let weight = weight_per_area(model.mass.iter().sum::<f64>() / model.vertex_area.iter().sum::<f64>());
                 let b = model.bending_stiffness.rigidity_at(-model.warp_angle);
                 Measures::Cantilever(CantileverMeasures {
                     tip_drop: drop,
                     tip_reach: tip.x,
                     tip_angle_deg: (-tangent.z).atan2(tangent.x).to_degrees(),
                     chord_angle_deg: drop.atan2(tip.x).to_degrees(),
-                    lambda: weight * r.length.powi(3) / b,
-                    bending_length: (b / weight).cbrt(),
+                    lambda: cantilever_lambda(weight, r.length, b),
+                    bending_length: bending_length(b, weight),
                 })
             }
             Rig::Arc(r) => {

@@ -354,19 +354,25 @@ impl BendingStiffness {
         let poisson_term = fabric.poisson_warp * bx;
         // G h³/12 with G in Pa = (sheet modulus / h) · h³ / 12.
         let twist_paper = fabric.shear_modulus * fabric.thickness * fabric.thickness / 12.0;
-        let (d12, d66) = match fabric.bending_bias {
-            None => (poisson_term, twist_paper),
-            Some(bias) => {
-                let middle = 4.0 * bias - bx - by;
-                if middle <= 0.0 {
-                    return Err(FabricError::BiasTooSmall { bias, warp: bx, weft: by, min: (bx + by) / 4.0 * 1.001 });
-                }
-                // Keep the Poisson coupling where the middle term allows it; the rest is twist.
-                let d12 = poisson_term.min(0.25 * middle);
-                (d12, 0.25 * (middle - 2.0 * d12))
+        match fabric.bending_bias {
+            None => Ok(Self { d11: bx, d12: poisson_term, d22: by, d66: twist_paper }),
+            Some(bias) if 4.0 * bias - bx - by <= 0.0 => {
+                Err(FabricError::BiasTooSmall { bias, warp: bx, weft: by, min: (bx + by) / 4.0 * 1.001 })
             }
-        };
-        Ok(Self { d11: bx, d12, d22: by, d66 })
+            Some(bias) => Ok(Self::with_bias_rigidity(bx, by, fabric.poisson_warp, bias)),
+        }
+    }
+
+    /// Eq. 3 with a measured bias rigidity `bias` (N·m) in place of the paper's middle term
+    /// (docs/references.md §1): 2 D12 + 4 D66 = 4 B_45 − B_x − B_y, split so that D12 keeps
+    /// the Poisson coupling ν_xy·B_x where the term allows it and the rest is twist, D66.
+    /// The term must be positive; [`BendingStiffness::new`] refuses a `bias` that makes it
+    /// not ([`FabricError::BiasTooSmall`]), and other callers keep `bias` above (B_x + B_y)/4.
+    pub fn with_bias_rigidity(bending_warp: f64, bending_weft: f64, poisson_warp: f64, bias: f64) -> Self {
+        let (bx, by) = (bending_warp, bending_weft);
+        let middle = 4.0 * bias - bx - by;
+        let d12 = (poisson_warp * bx).min(0.25 * middle);
+        Self { d11: bx, d12, d22: by, d66: 0.25 * (middle - 2.0 * d12) }
     }
 
     /// Isotropic stiffness with rigidity `b` in every direction (D12 + 2 D66 = b, no Poisson coupling).

@@ -2,8 +2,9 @@
 //!
 //! faer's own numeric factorisation and solves walk the supernodes one after another, and
 //! on the fine drapes they are what a run waits for: a solve reads the whole factor twice,
-//! and the factor grows faster than the mesh. faer's rayon mode parallelises the dense work inside each supernode, and on these small
-//! supernodes it was slower (see `direct::PARALLELISM`). Here the elimination tree is cut
+//! and the factor grows faster than the mesh. faer's rayon mode parallelises the dense work
+//! inside each supernode, and on these small supernodes it was slower (see
+//! `direct::PARALLELISM`). Here the elimination tree is cut
 //! instead: two groups of disjoint subtrees, of about equal size, are worked at once, one
 //! per thread, and the few supernodes above both (the last separators) after them
 //! (factorisation, forward substitution) or before them (back substitution).

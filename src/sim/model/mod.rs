@@ -42,7 +42,7 @@ pub struct PhysicsOptions {
 
 impl Default for PhysicsOptions {
     fn default() -> Self {
-        Self { membrane: true, bending: true, gravity: DVec3::new(0.0, 0.0, -9.81), damping: 0.0 }
+        Self { membrane: true, bending: true, gravity: DVec3::new(0.0, 0.0, -crate::physics::STANDARD_GRAVITY), damping: 0.0 }
     }
 }
 

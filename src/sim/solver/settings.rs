@@ -40,7 +40,7 @@ pub struct NewtonSettings {
     /// (the drape, Euler buckling, the cantilever) but costs more where it flutters (shear
     /// buckling's wrinkles), and on the drape its tolerance-sized differences, amplified by
     /// the choice of folds, widen the scatter of the drape coefficient between random
-    /// seeds (figures in docs/performance-log.md, the morning of 2026-11-30).
+    /// seeds (docs/performance-log.md has the figures and the commands that give them).
     pub warm_start: bool,
     /// The conjugate gradient's preconditioner.
     pub preconditioner: PreconditionerChoice,

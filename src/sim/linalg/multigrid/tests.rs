@@ -74,7 +74,7 @@ struct Sheet {
 
 fn sheet(size: f64, edge: f64) -> Sheet {
     let mesh = Mesh::rectangle(size, size, edge, Pattern::Jittered, 3).expect("mesh");
-    let options = PhysicsOptions { membrane: true, bending: true, gravity: DVec3::new(0.0, 0.0, -9.81), damping: 0.0 };
+    let options = PhysicsOptions { membrane: true, bending: true, gravity: DVec3::new(0.0, 0.0, -crate::physics::STANDARD_GRAVITY), damping: 0.0 };
     let mut model = Model::new(&mesh, &wool(), 0.3, options).expect("model");
     let shape = |p: DVec2| DVec3::new(1.01 * p.x, 1.01 * p.y, 0.05 * (p.x / size) * (p.x / size) + 0.01 * (3.0 * p.y / size).sin());
     let x: Vec<DVec3> = model.rest.iter().map(|&p| shape(p)).collect();
