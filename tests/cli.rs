@@ -134,7 +134,7 @@ fn run_bundled_with(name: &str, overrides: &[&str]) {
 }
 
 /// Every bundled scene has its own test below (so that they run in parallel).
-const COVERED: [&str; 11] = [
+const COVERED: [&str; 16] = [
     "tensile-warp",
     "tensile-weft",
     "tensile-bias",
@@ -146,6 +146,11 @@ const COVERED: [&str; 11] = [
     "cusick-drape-30",
     "tablecloth",
     "sphere-drop",
+    "swing",
+    "skirt-circle",
+    "skirt-gored-straight",
+    "skirt-gored-bias",
+    "shift-dress",
 ];
 
 #[test]
@@ -205,6 +210,43 @@ fn runs_tablecloth() {
 #[test]
 fn runs_sphere_drop() {
     run_bundled_with("sphere-drop", &["mesh.edge_length=0.04"]);
+}
+
+#[test]
+fn runs_swing() {
+    run_bundled("swing");
+}
+
+/// The garments on 5 cm edges for 1.5 s, past their sewing time (the bundled meshes run in
+/// tests/garment.rs and take a minute each). The gored skirts are sewn, out of the form and
+/// free of self-intersection. Every garment's run is honest about its seams: sewn (exit 0),
+/// or exit 8 naming garment.sewing_time with its metrics written and `sewn` false.
+#[test]
+fn runs_garments() {
+    for name in ["skirt-gored-straight", "skirt-gored-bias", "skirt-circle", "shift-dress"] {
+        let path = metrics_path(name);
+        let out = rosette(&["run", name, "--set", "mesh.edge_length=0.05", "--duration", "1.5", "--metrics", path.to_str().unwrap()]);
+        let written = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{name}: no metrics ({e}): {}", text(&out.stderr)));
+        std::fs::remove_file(&path).ok();
+        let metrics: Value = serde_json::from_str(&written).unwrap();
+        let typed: Metrics = serde_json::from_str(&written).unwrap_or_else(|e| panic!("{name}: the metrics do not read back: {e}"));
+        let garment = typed.measures.garment().unwrap_or_else(|| panic!("{name}: no garment measures"));
+        assert_eq!(metrics["stable"], true, "{name}");
+        match out.status.code() {
+            Some(0) => assert!(garment.sewn, "{name}: exit 0 for an unsewn garment"),
+            Some(8) => {
+                assert!(!garment.sewn, "{name}: exit 8 for a sewn garment");
+                assert!(text(&out.stderr).contains("garment.sewing_time"), "{name}: {}", text(&out.stderr));
+            }
+            code => panic!("{name}: exit {code:?}: {}", text(&out.stderr)),
+        }
+        if name.starts_with("skirt-gored") {
+            let (config, _) = load_scene(name, &[]).unwrap();
+            assert_eq!(out.status.code(), Some(0), "{name}: {}", text(&out.stderr));
+            assert!(metrics["max_penetration"].as_f64().unwrap() < config.contact.thickness, "{name}: {}", metrics["max_penetration"]);
+            assert_eq!(metrics["self_intersections"].as_u64(), Some(0), "{name}");
+        }
+    }
 }
 
 /// `--outline` writes the shadow outline of a drape: one row per half degree, radii between

@@ -218,19 +218,21 @@ fn card_compare_and_import_never_write_over_their_inputs() {
             failures.push(e);
         }
     }
-    // A fabric file named d14.json: the card's DIR/d14.json would be that file.
+    // A fabric named d14.json (an ARCSim material, the one kind of fabric file that ends in
+    // .json): the card's DIR/d14.json would be that file.
     let fabric = dir.join("d14.json");
-    std::fs::write(&fabric, &sheet_text).unwrap();
+    let material_text = bundled("presets/fabrics/arcsim/11oz-black-denim.json");
+    std::fs::write(&fabric, &material_text).unwrap();
     for out in [dir.clone(), dir.join(".")] {
         let result = rosette(&strings(&["card", fabric.to_str().unwrap(), "--out", out.to_str().unwrap(), "--force"]));
-        if let Err(e) = assert_refused_intact("card d14.json --out .", &result, &["--out", "reads"], &[(&fabric, sheet_text.as_bytes())]) {
+        if let Err(e) = assert_refused_intact("card d14.json --out .", &result, &["--out", "reads"], &[(&fabric, material_text.as_bytes())]) {
             failures.push(e);
         }
     }
     // compare's FILE.json beside its picture.
     let sheet_png = dir.join("d14.png");
     let result = rosette(&strings(&["compare", fabric.to_str().unwrap(), "silk", "--out", sheet_png.to_str().unwrap(), "--force"]));
-    if let Err(e) = assert_refused_intact("compare d14.json --out d14.png", &result, &["--out", "reads"], &[(&fabric, sheet_text.as_bytes())]) {
+    if let Err(e) = assert_refused_intact("compare d14.json --out d14.png", &result, &["--out", "reads"], &[(&fabric, material_text.as_bytes())]) {
         failures.push(e);
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));

@@ -7,7 +7,7 @@
 mod common;
 
 use common::run;
-use rosette::scene::GRAVITY;
+use rosette::physics::STANDARD_GRAVITY as GRAVITY;
 
 /// The first zero of the Bessel function J₀ (Abramowitz and Stegun, Table 9.5).
 const J0_FIRST_ZERO: f64 = 2.404_825_557_7;

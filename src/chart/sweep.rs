@@ -3,7 +3,8 @@
 //! explicit stability limit each run is compared with.
 
 use crate::reference::{euler_elastica_from_shortening, heavy_cantilever};
-use crate::scene::{GRAVITY, Measures, RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use crate::physics::{cantilever_lambda, weight_per_area};
+use crate::scene::{Measures, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 use crate::scene::levels::SolverPath;
 use crate::sim::IntegratorKind;
 use glam::DVec3;
@@ -258,8 +259,8 @@ fn measure_error(problem: Problem, config: &SceneConfig, measures: &Measures) ->
     match problem {
         Problem::Cantilever => {
             // λ = w L³ / B with B the warp rigidity: the strip is cut along the warp.
-            let weight = config.fabric.properties.areal_density * GRAVITY;
-            let lambda = weight * length.powi(3) / config.fabric.properties.bending_warp;
+            let weight = weight_per_area(config.fabric.properties.areal_density);
+            let lambda = cantilever_lambda(weight, length, config.fabric.properties.bending_warp);
             let exact = heavy_cantilever(lambda).tip_drop_over_l;
             let drop = measures.cantilever().ok_or_else(other_rig)?.tip_drop / length;
             Ok((drop, Some((drop - exact).abs() / exact)))

@@ -151,19 +151,26 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
         pattern::check_simple(&panel.name, &edge_names, &c)?;
         curves.push(c);
     }
+    // Refinement leaves triangles of about (√3/4) h²: refuse a mesh past the vertex cap
+    // before making it (or the seams' samples, whose counts go as 1/h).
+    let area: f64 = curves.iter().map(|c| c.iter().flat_map(|e| e.points.windows(2)).map(|w| 0.5 * w[0].perp_dot(w[1])).sum::<f64>()).sum();
+    let planned = 0.5 * area / (0.433 * edge_length * edge_length);
+    let limit = crate::sim::mesh::MAX_VERTICES as f64;
+    if !(planned <= limit) {
+        use crate::io::number::short;
+        // The edge that gives the limit: the count goes as 1/h².
+        let least = (0.5 * area / (0.433 * limit)).sqrt();
+        return Err(GarmentError::new(format!(
+            "mesh.edge_length = {} m gives about {} vertices, more than the limit of {}; use at least {}",
+            short(edge_length),
+            short(planned),
+            crate::sim::mesh::MAX_VERTICES,
+            short(least)
+        )));
+    }
     let lengths: Vec<Vec<f64>> = curves.iter().map(|c| c.iter().map(Polyline::length).collect()).collect();
     let (sides, counts) = seam_sides(config, &names, &lengths, edge_length)?;
     let cuts = seams::cuts(&lengths, &sides, &counts, edge_length, &names)?;
-    // Refinement leaves triangles of about (√3/4) h²: refuse a mesh past the vertex cap
-    // before making it.
-    let area: f64 = curves.iter().map(|c| c.iter().flat_map(|e| e.points.windows(2)).map(|w| 0.5 * w[0].perp_dot(w[1])).sum::<f64>()).sum();
-    let planned = (area / (0.433 * edge_length * edge_length)) as usize / 2;
-    if planned > crate::sim::mesh::MAX_VERTICES {
-        return Err(GarmentError::new(format!(
-            "mesh.edge_length = {edge_length} m gives about {planned} vertices, more than the limit of {}; use a larger edge",
-            crate::sim::mesh::MAX_VERTICES
-        )));
-    }
     let meshes: Vec<PanelMesh> =
         config.panels.iter().zip(&curves).zip(&cuts).map(|((p, c), cut)| mesh::mesh_panel(&p.name, c, cut, edge_length)).collect::<Result<_, _>>()?;
     let grains: Vec<f64> = config.panels.iter().map(|p| p.grain_deg.to_radians()).collect();

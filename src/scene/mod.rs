@@ -23,6 +23,7 @@ pub use run::{ContactEvents, Metrics, RunOptions, SettleWatch, StepRecord, run_s
 
 use crate::sim::contact::ContactModel;
 use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, StepError, StepReport};
+use crate::physics::STANDARD_GRAVITY;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rigs::Rig;
@@ -56,9 +57,6 @@ pub struct Scene {
     pub garment: Option<garment::Sewing>,
 }
 
-/// Standard gravity, m/s²: `scene`'s name for [`crate::physics::STANDARD_GRAVITY`], kept
-/// for the modules that still import it by this name.
-pub use crate::physics::STANDARD_GRAVITY as GRAVITY;
 
 /// From this many triangles a step runs on rayon's pool (`Scene::step`): the size from
 /// which the model's, the contact's and the matrices' loops run in parallel (4 096
@@ -89,7 +87,7 @@ impl Scene {
         let options = PhysicsOptions {
             membrane: level_config.physics.membrane,
             bending: level_config.physics.bending,
-            gravity: if level_config.physics.gravity { DVec3::new(0.0, 0.0, -GRAVITY) } else { DVec3::ZERO },
+            gravity: if level_config.physics.gravity { DVec3::new(0.0, 0.0, -STANDARD_GRAVITY) } else { DVec3::ZERO },
             damping: level_config.solver.damping,
         };
         if level_config.scene.kind == SceneKind::Garment {
@@ -183,7 +181,7 @@ impl Scene {
         if let (Some(ramp), true) = (self.config.scene.gravity_ramp, self.config.physics.gravity) {
             // Gravity at the end of the step, which is where implicit steps evaluate forces.
             let t = self.state.time + self.integrator.dt;
-            self.model.options.gravity = DVec3::new(0.0, 0.0, -GRAVITY * (t / ramp).min(1.0));
+            self.model.options.gravity = DVec3::new(0.0, 0.0, -STANDARD_GRAVITY * (t / ramp).min(1.0));
         }
         self.sew_before_step();
         let report = self.integrator.step(&self.model, &mut self.state)?;

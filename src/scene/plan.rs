@@ -18,6 +18,7 @@
 
 use super::levels::SolverPath;
 use super::{SceneConfig, SceneError, SceneKind};
+use crate::physics::{bending_length, weight_per_area};
 use crate::sim::PreconditionerChoice;
 use std::fmt::Write as _;
 
@@ -169,9 +170,8 @@ fn design(config: &SceneConfig) -> Design {
 /// of the fabric's bending length (B/w)^(1/3), m (the weaker direction's).
 fn coarsest_edge(config: &SceneConfig) -> Result<f64, crate::sim::FabricError> {
     let fabric = config.material()?;
-    let weight = fabric.weight_per_area(super::GRAVITY);
-    let bending_length = (fabric.bending_warp.min(fabric.bending_weft) / weight).cbrt();
-    Ok(config.solver.fast.coarsest_edge_share * bending_length)
+    let weight = weight_per_area(fabric.areal_density);
+    Ok(config.solver.fast.coarsest_edge_share * bending_length(fabric.bending_warp.min(fabric.bending_weft), weight))
 }
 
 /// Newton's iteration limit on the fast path's long steps.

@@ -32,6 +32,7 @@ pub struct SwingMeasures {
     pub half_periods: usize,
     /// The period measured, twice the mean time between zero crossings, s; None with fewer
     /// than two half periods (a run too short to tell).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub swing_period: Option<f64>,
 }
 

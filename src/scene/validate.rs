@@ -35,7 +35,7 @@ pub(super) fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
 }
 
 /// Positive and at most `max` (`why` says what the bound is).
-fn positive_at_most(key: &str, v: f64, max: f64, why: &str) -> Result<f64, Invalid> {
+pub(super) fn positive_at_most(key: &str, v: f64, max: f64, why: &str) -> Result<f64, Invalid> {
     positive(key, v)?;
     if v > max {
         return Err(invalid(key, format!("{key} = {} is more than {} ({why})", short(v), short(max))));

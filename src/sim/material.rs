@@ -206,11 +206,6 @@ impl Fabric {
         fabric.validate()?;
         Ok(fabric)
     }
-
-    /// Weight per unit area, N/m², under gravity `g` (m/s²).
-    pub fn weight_per_area(&self, g: f64) -> f64 {
-        self.areal_density * g
-    }
 }
 
 /// The in-plane strain energy density ψ(ε_xx, ε_yy, γ_xy), J/m², of an orthotropic sheet with

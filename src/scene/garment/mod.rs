@@ -150,7 +150,9 @@ pub fn check(c: &SceneConfig) -> Result<f64, super::validate::Invalid> {
         return Err(invalid("cloth", "a garment's cloth is its [garment] pattern; remove the [cloth] section (each panel has its own grain_deg and placement)".into()));
     }
     let h = positive("mesh.edge_length", c.mesh.edge_length)?;
-    positive("garment.sewing_stiffness", g.sewing_stiffness)?;
+    // Springs far stiffer than the cloth they close only make the step's solve
+    // ill-conditioned: at the limit a 1 µm gap already pulls with 1 N.
+    super::validate::positive_at_most("garment.sewing_stiffness", g.sewing_stiffness, MAX_SEWING_STIFFNESS, "a sewing spring's stiffness in N/m; the default is 50")?;
     positive("garment.sewing_ramp", g.sewing_ramp)?;
     positive("garment.sewing_time", g.sewing_time)?;
     positive("garment.closed_share", g.closed_share)?;
@@ -183,6 +185,9 @@ pub fn check(c: &SceneConfig) -> Result<f64, super::validate::Invalid> {
     }
     Ok(extent)
 }
+
+/// The stiffest sewing spring a scene may ask for, N/m.
+const MAX_SEWING_STIFFNESS: f64 = 1e6;
 
 /// Refuses a panel that starts inside the form (or within its contact layer).
 fn check_outside(garment: &Garment, form: &Prop, thickness: f64) -> Result<(), SceneError> {

@@ -174,6 +174,9 @@ impl Integrator {
                 // The pairs no longer describe Φ here: start afresh from the constant matrix.
                 pairs.clear();
                 self.lbfgs_direction(&pairs, &gradient, &mut direction, &mut watch);
+                if problem.all_free {
+                    keep_momentum(&problem.mass_diagonal, &gradient, &mut direction);
+                }
                 slope = dot(&gradient, &direction);
                 if slope >= 0.0 {
                     break;
@@ -213,8 +216,15 @@ impl Integrator {
             }
             let Some(mut value) = accepted else {
                 // Φ cannot be lowered along the direction: round-off level if it is short.
+                // A short direction is still taken: it changes Φ by round-off, and on a free
+                // sheet it leaves no net force (momentum is kept).
                 if pairs.is_empty() {
                     report.newton_unconverged = length >= problem.tolerance;
+                    if !report.newton_unconverged {
+                        for i in 0..n {
+                            y[i] += direction[i];
+                        }
+                    }
                     break;
                 }
                 pairs.clear();
