@@ -83,14 +83,7 @@ pub fn is_arcsim_file(spec: &str) -> bool {
 /// An ARCSim material file read as a fabric: the file is the fabric's `[arcsim]` section
 /// (`data = "FILE"`), named after the file.
 fn load_arcsim(spec: &str) -> Result<LoadedFabric, LoadError> {
-    let stem = std::path::Path::new(spec).file_stem().map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into_owned());
-    let mut table = toml::Table::new();
-    table.insert("name".into(), toml::Value::String(format!("{stem} (ARCSim material)")));
-    table.insert("description".into(), toml::Value::String(format!("ARCSim material {spec}, imported by Rosette's projection")));
-    let mut section = toml::Table::new();
-    section.insert("data".into(), toml::Value::String(spec.into()));
-    table.insert("arcsim".into(), toml::Value::Table(section));
-    from_table(table, spec)
+    from_table(crate::scene::preset::arcsim_fabric_table(spec), spec)
 }
 
 /// Loads a bundled fabric by name (`wool`), a fabric file by path, or an ARCSim material

@@ -422,14 +422,32 @@ pub(super) fn read_table(kind: &'static str, spec: &str, list: &'static [Bundled
         let available = list.iter().map(|b| b.name).collect::<Vec<_>>().join(", ");
         return Err(PresetError::Unknown { kind, name: spec.to_string(), available });
     }
+    let file = path.display().to_string();
+    if kind == "fabric" && crate::fabric::is_arcsim_file(spec) {
+        // An ARCSim material stands for a fabric file whose `[arcsim]` section reads it.
+        read_text(&path, FileKind::Arcsim).map_err(|source| PresetError::Read { key: "fabric.preset", source })?;
+        return Ok((arcsim_fabric_table(&file), file));
+    }
     let (file_kind, key) = if kind == "fabric" { (FileKind::Fabric, "fabric.preset") } else { (FileKind::Scene, "scene") };
     let text = read_text(&path, file_kind).map_err(|source| PresetError::Read { key, source })?;
-    let file = path.display().to_string();
     let table = parse_toml(&text, Some(&path), file_kind).map_err(|message| PresetError::Syntax { file: file.clone(), message })?;
     if kind == "fabric" {
         refuse_fabric_preset(&table).map_err(|message| PresetError::Invalid { file: file.clone(), message })?;
     }
     Ok((table, file))
+}
+
+/// The fabric table an ARCSim material file `file` (`….json`) stands for: named after the
+/// file, its `[arcsim]` section reading it.
+pub fn arcsim_fabric_table(file: &str) -> toml::Table {
+    let stem = Path::new(file).file_stem().map_or_else(|| file.to_string(), |s| s.to_string_lossy().into_owned());
+    let mut table = toml::Table::new();
+    table.insert("name".into(), toml::Value::String(format!("{stem} (ARCSim material)")));
+    table.insert("description".into(), toml::Value::String(format!("ARCSim material {file}, imported by Rosette's projection")));
+    let mut section = toml::Table::new();
+    section.insert("data".into(), toml::Value::String(file.into()));
+    table.insert("arcsim".into(), toml::Value::Table(section));
+    table
 }
 
 /// A fabric file stands alone: `preset` (a fabric to start from) is read only in a scene's

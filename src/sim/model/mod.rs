@@ -296,7 +296,12 @@ impl Model {
             }
         }
         energy += self.add_membrane_energy_and_forces(x, f);
-        energy + self.add_bending_energy_and_forces(x, f)
+        energy += self.add_bending_energy_and_forces(x, f);
+        if self.sewing.is_active() {
+            self.sewing.add_forces(x, f);
+            energy += self.sewing.energy(x);
+        }
+        energy
     }
 
     /// A zero matrix with the in-plane stiffness pattern.
