@@ -113,6 +113,8 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
         model.pin(v, x[v as usize]);
     }
     model.sewing.anchors = anchors(&garment, &form, axis, thickness);
+    model.sewing.start(&x);
+    model.sewing.slack = 1.0;
     let (welded_surface, weld_map) = weld_surface(&garment.surface, &pairs);
     let mut welded = Model::from_panels(&welded_surface, &[], fabric, options)?;
     let mut props = super::props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
@@ -322,7 +324,8 @@ impl Scene {
             return;
         }
         let t = self.state.time + self.integrator.dt;
-        self.model.sewing.stiffness = sewing.stiffness * (t / sewing.ramp).min(1.0);
+        self.model.sewing.stiffness = sewing.stiffness;
+        self.model.sewing.slack = (1.0 - t / sewing.ramp).max(0.0);
         self.model.options.damping = sewing.damping.0;
     }
 
