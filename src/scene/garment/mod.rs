@@ -188,6 +188,10 @@ pub fn check(c: &SceneConfig) -> Result<f64, super::validate::Invalid> {
     Ok(extent)
 }
 
+/// How long the sewing springs take to double their stiffness once the sewing's
+/// schedule has run out with a seam still open, s.
+const STIFFEN_DOUBLING: f64 = 0.05;
+
 /// The stiffest sewing spring a scene may ask for, N/m.
 const MAX_SEWING_STIFFNESS: f64 = 1e6;
 
@@ -324,8 +328,12 @@ impl Scene {
             return;
         }
         let t = self.state.time + self.integrator.dt;
-        self.model.sewing.stiffness = sewing.stiffness;
         self.model.sewing.slack = (1.0 - t / sewing.ramp).max(0.0);
+        // Past its schedule a seam held open by a load (a waist pulled round the form)
+        // is drawn tighter: the springs stiffen twofold every STIFFEN_DOUBLING seconds
+        // until it closes, up to the largest stiffness a scene may ask for.
+        let late = ((t - sewing.ramp) / STIFFEN_DOUBLING).max(0.0);
+        self.model.sewing.stiffness = (sewing.stiffness * late.exp2()).min(MAX_SEWING_STIFFNESS.max(sewing.stiffness));
         self.model.options.damping = sewing.damping.0;
     }
 
