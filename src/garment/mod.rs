@@ -57,10 +57,12 @@ pub struct GarmentConfig {
     /// beyond it is a pattern error).
     #[serde(default = "default_seam_ease")]
     pub seam_ease: f64,
-    /// The sewing springs' final stiffness, N/m.
+    /// The sewing springs' stiffness, N/m (doubled every 0.05 s past the ramp while a
+    /// seam is still open).
     #[serde(default = "default_sewing_stiffness")]
     pub sewing_stiffness: f64,
-    /// Time over which the springs grow from zero to full, s.
+    /// Time over which the springs' rest lengths shrink from the seams' starting gaps to
+    /// zero (the seams close on this schedule), s.
     #[serde(default = "default_sewing_ramp")]
     pub sewing_ramp: f64,
     /// Air damping while the seams close, 1/s (the scene's `solver.damping` from the weld):

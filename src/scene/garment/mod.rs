@@ -4,8 +4,10 @@
 //! ```text
 //!   build: panels meshed and placed, the form as a mesh prop, the welded model made
 //!          up front (so a pattern that cannot be welded is refused before any work)
-//!   sew:   springs k(t) = k·min(t/ramp, 1) pull seam pairs together and attached edges
-//!          onto the form; self-collision off (the seam's two sides must meet)
+//!   sew:   springs ½k·max(0, d − s(t)·d₀)², the slack s(t) = max(0, 1 − t/ramp), pull
+//!          seam pairs together and attached edges onto the form on schedule, then
+//!          stiffen while a seam is still held open; self-collision off (the seam's two
+//!          sides must meet)
 //!   weld:  once every pair is within `closed_share` of the contact thickness: pairs
 //!          merged, the welded model takes over (membrane and bending across the seams),
 //!          attached vertices pinned where they are, self-collision on
@@ -320,8 +322,8 @@ fn weld_surface(surface: &PanelSurface, pairs: &[[u32; 2]]) -> (PanelSurface, Ve
 }
 
 impl Scene {
-    /// Before a step of a garment still being sewn: the springs' stiffness at the step's
-    /// end time.
+    /// Before a step of a garment still being sewn: the springs' slack and stiffness at
+    /// the step's end time.
     pub(super) fn sew_before_step(&mut self) {
         let Some(sewing) = &self.garment else { return };
         if sewing.is_sewn() {
