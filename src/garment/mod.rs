@@ -158,7 +158,7 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
     let area: f64 = curves.iter().map(|c| c.iter().flat_map(|e| e.points.windows(2)).map(|w| 0.5 * w[0].perp_dot(w[1])).sum::<f64>()).sum();
     let planned = 0.5 * area / (0.433 * edge_length * edge_length);
     let limit = crate::sim::mesh::MAX_VERTICES as f64;
-    if !(planned <= limit) {
+    if planned.is_nan() || planned > limit {
         use crate::io::number::short;
         // The edge that gives the limit: the count goes as 1/h².
         let least = (0.5 * area / (0.433 * limit)).sqrt();
