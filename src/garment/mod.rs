@@ -57,10 +57,12 @@ pub struct GarmentConfig {
     /// beyond it is a pattern error).
     #[serde(default = "default_seam_ease")]
     pub seam_ease: f64,
-    /// The sewing springs' final stiffness, N/m.
+    /// The sewing springs' stiffness, N/m (doubled every 0.05 s past the ramp while a
+    /// seam is still open).
     #[serde(default = "default_sewing_stiffness")]
     pub sewing_stiffness: f64,
-    /// Time over which the springs grow from zero to full, s.
+    /// Time over which the springs' rest lengths shrink from the seams' starting gaps to
+    /// zero (the seams close on this schedule), s.
     #[serde(default = "default_sewing_ramp")]
     pub sewing_ramp: f64,
     /// Air damping while the seams close, 1/s (the scene's `solver.damping` from the weld):
@@ -156,7 +158,7 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
     let area: f64 = curves.iter().map(|c| c.iter().flat_map(|e| e.points.windows(2)).map(|w| 0.5 * w[0].perp_dot(w[1])).sum::<f64>()).sum();
     let planned = 0.5 * area / (0.433 * edge_length * edge_length);
     let limit = crate::sim::mesh::MAX_VERTICES as f64;
-    if !(planned <= limit) {
+    if planned.is_nan() || planned > limit {
         use crate::io::number::short;
         // The edge that gives the limit: the count goes as 1/h².
         let least = (0.5 * area / (0.433 * limit)).sqrt();

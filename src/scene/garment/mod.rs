@@ -4,8 +4,10 @@
 //! ```text
 //!   build: panels meshed and placed, the form as a mesh prop, the welded model made
 //!          up front (so a pattern that cannot be welded is refused before any work)
-//!   sew:   springs k(t) = k·min(t/ramp, 1) pull seam pairs together and attached edges
-//!          onto the form; self-collision off (the seam's two sides must meet)
+//!   sew:   springs ½k·max(0, d − s(t)·d₀)², the slack s(t) = max(0, 1 − t/ramp), pull
+//!          seam pairs together and attached edges onto the form on schedule, then
+//!          stiffen while a seam is still held open; self-collision off (the seam's two
+//!          sides must meet)
 //!   weld:  once every pair is within `closed_share` of the contact thickness: pairs
 //!          merged, the welded model takes over (membrane and bending across the seams),
 //!          attached vertices pinned where they are, self-collision on
@@ -113,6 +115,8 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
         model.pin(v, x[v as usize]);
     }
     model.sewing.anchors = anchors(&garment, &form, axis, thickness);
+    model.sewing.start(&x);
+    model.sewing.slack = 1.0;
     let (welded_surface, weld_map) = weld_surface(&garment.surface, &pairs);
     let mut welded = Model::from_panels(&welded_surface, &[], fabric, options)?;
     let mut props = super::props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
@@ -185,6 +189,10 @@ pub fn check(c: &SceneConfig) -> Result<f64, super::validate::Invalid> {
     }
     Ok(extent)
 }
+
+/// How long the sewing springs take to double their stiffness once the sewing's
+/// schedule has run out with a seam still open, s.
+const STIFFEN_DOUBLING: f64 = 0.05;
 
 /// The stiffest sewing spring a scene may ask for, N/m.
 const MAX_SEWING_STIFFNESS: f64 = 1e6;
@@ -314,15 +322,20 @@ fn weld_surface(surface: &PanelSurface, pairs: &[[u32; 2]]) -> (PanelSurface, Ve
 }
 
 impl Scene {
-    /// Before a step of a garment still being sewn: the springs' stiffness at the step's
-    /// end time.
+    /// Before a step of a garment still being sewn: the springs' slack and stiffness at
+    /// the step's end time.
     pub(super) fn sew_before_step(&mut self) {
         let Some(sewing) = &self.garment else { return };
         if sewing.is_sewn() {
             return;
         }
         let t = self.state.time + self.integrator.dt;
-        self.model.sewing.stiffness = sewing.stiffness * (t / sewing.ramp).min(1.0);
+        self.model.sewing.slack = (1.0 - t / sewing.ramp).max(0.0);
+        // Past its schedule a seam held open by a load (a waist pulled round the form)
+        // is drawn tighter: the springs stiffen twofold every STIFFEN_DOUBLING seconds
+        // until it closes, up to the largest stiffness a scene may ask for.
+        let late = ((t - sewing.ramp) / STIFFEN_DOUBLING).max(0.0);
+        self.model.sewing.stiffness = (sewing.stiffness * late.exp2()).min(MAX_SEWING_STIFFNESS.max(sewing.stiffness));
         self.model.options.damping = sewing.damping.0;
     }
 

@@ -129,7 +129,7 @@ impl Model {
         use rayon::prelude::*;
         k.clear();
         if self.sewing.is_active() {
-            self.sewing.add_stiffness(k);
+            self.sewing.add_stiffness(x, k);
         }
         let Some(law) = &self.membrane_law else { return };
         // Each vertex's scale for the compressed edges it ends (0: dropped).

@@ -68,9 +68,13 @@ impl PanelSurface {
     }
 }
 
-/// Zero-length springs: ½ k |x_a − x_b|² for each seam pair and ½ k |x_v − p|² for each
-/// attached vertex v and its anchor p, with one stiffness k that the scene ramps up while
-/// it sews (a fixed model would snap the panels together in one step).
+/// Sewing springs: ½ k max(0, d − L)² for each seam pair at distance d and for each
+/// attached vertex at distance d from its anchor, with one stiffness k and a rest length L
+/// that the scene shrinks while it sews: L = s·d₀, d₀ the spring's length when the sewing
+/// began and s its slack, going from 1 to 0. A spring only pulls where the seam lags its
+/// schedule, so the seams close at the pace the slack sets, however far apart the panels
+/// start (a zero-length spring's pull grows with the gap, and snaps distant panels
+/// together in a few steps); at s = 0 the springs have zero length.
 #[derive(Debug, Clone, Default)]
 pub struct Sewing {
     /// Seam vertex pairs the springs join.
@@ -79,6 +83,11 @@ pub struct Sewing {
     pub anchors: Vec<(u32, DVec3)>,
     /// Spring stiffness, N/m (zero: the springs are off).
     pub stiffness: f64,
+    /// Each spring's length when the sewing began, m: the pairs', then the anchors'
+    /// (empty: zero-length springs).
+    pub start_lengths: Vec<f64>,
+    /// The share of its starting length each spring may still have, 1 to 0.
+    pub slack: f64,
 }
 
 impl Sewing {
@@ -86,44 +95,70 @@ impl Sewing {
         self.stiffness > 0.0 && !(self.pairs.is_empty() && self.anchors.is_empty())
     }
 
+    /// Records every spring's present length as its starting length.
+    pub fn start(&mut self, x: &[DVec3]) {
+        let pairs = self.pairs.iter().map(|&[a, b]| x[a as usize].distance(x[b as usize]));
+        self.start_lengths = pairs.chain(self.anchors.iter().map(|&(v, p)| x[v as usize].distance(p))).collect();
+    }
+
+    /// Every spring: its two ends (the second a point for an anchor) and its rest length.
+    fn springs<'a>(&'a self, x: &'a [DVec3]) -> impl Iterator<Item = (u32, Option<u32>, DVec3, f64)> + 'a {
+        let rest = move |i: usize| self.slack * self.start_lengths.get(i).copied().unwrap_or(0.0);
+        let pairs = self.pairs.iter().map(|&[a, b]| (a, Some(b), x[b as usize]));
+        let anchors = self.anchors.iter().map(|&(v, p)| (v, None, p));
+        pairs.chain(anchors).enumerate().map(move |(i, (a, b, to))| (a, b, to, rest(i)))
+    }
+
     /// Energy of the springs, J.
     pub fn energy(&self, x: &[DVec3]) -> f64 {
         let k = self.stiffness;
-        let seams: f64 = self.pairs.iter().map(|&[a, b]| 0.5 * k * x[a as usize].distance_squared(x[b as usize])).sum();
-        let anchors: f64 = self.anchors.iter().map(|&(v, p)| 0.5 * k * x[v as usize].distance_squared(p)).sum();
-        seams + anchors
+        self.springs(x).map(|(a, _, to, rest)| 0.5 * k * (x[a as usize].distance(to) - rest).max(0.0).powi(2)).sum()
     }
 
     /// Adds the springs' forces −∇E to `f`.
     ///
     /// ```text
-    ///   a ●~~~~~~~~● b     a seam pair: f_a = k (x_b − x_a), f_b = −f_a
-    ///   v ●~~~~~~~~○ p     an attachment: f_v = k (p − x_v)
+    ///   a ●~~~~~~~~● b     a seam pair: f_a = k (d − L) n, n = (x_b − x_a)/d, f_b = −f_a
+    ///   v ●~~~~~~~~○ p     an attachment: f_v = k (d − L) n, n = (p − x_v)/d
     /// ```
     pub fn add_forces(&self, x: &[DVec3], f: &mut [DVec3]) {
         let k = self.stiffness;
-        for &[a, b] in &self.pairs {
-            let pull = k * (x[b as usize] - x[a as usize]);
+        for (a, b, to, rest) in self.springs(x) {
+            let r = to - x[a as usize];
+            let d = r.length();
+            if d <= rest || d == 0.0 {
+                continue;
+            }
+            let pull = k * (d - rest) / d * r;
             f[a as usize] += pull;
-            f[b as usize] -= pull;
-        }
-        for &(v, p) in &self.anchors {
-            f[v as usize] += k * (p - x[v as usize]);
+            if let Some(b) = b {
+                f[b as usize] -= pull;
+            }
         }
     }
 
-    /// Adds the springs' (constant) Hessian to `k`, whose pattern holds every pair.
-    pub fn add_stiffness(&self, k: &mut BlockCsr) {
-        let block = DMat3::from_diagonal(DVec3::splat(self.stiffness));
-        for &[a, b] in &self.pairs {
-            for (r, c, sign) in [(a, a, 1.0), (b, b, 1.0), (a, b, -1.0), (b, a, -1.0)] {
+    /// Adds the springs' Hessian to `k`, whose pattern holds every pair: for a stretched
+    /// spring k[(1 − L/d) I + (L/d) n nᵀ], positive semi-definite.
+    pub fn add_stiffness(&self, x: &[DVec3], k: &mut BlockCsr) {
+        for (a, b, to, rest) in self.springs(x) {
+            let r = to - x[a as usize];
+            let d = r.length();
+            if d <= rest {
+                continue;
+            }
+            let share = if d > 0.0 { rest / d } else { 0.0 };
+            let n = if d > 0.0 { r / d } else { DVec3::ZERO };
+            let block = self.stiffness * (DMat3::from_diagonal(DVec3::splat(1.0 - share)) + share * DMat3::from_cols(n * n.x, n * n.y, n * n.z));
+            let mut add = |r: u32, c: u32, sign: f64| {
                 let slot = k.slot(r, c);
                 k.values[slot] += block * sign;
+            };
+            add(a, a, 1.0);
+            if let Some(b) = b {
+                add(b, b, 1.0);
+                add(a, b, -1.0);
+                add(b, a, -1.0);
             }
-        }
-        for &(v, _) in &self.anchors {
-            let slot = k.slot(v, v);
-            k.values[slot] += block;
         }
     }
 
@@ -194,20 +229,44 @@ mod tests {
     /// Sewing springs: energy, forces and Hessian agree (central differences).
     #[test]
     fn springs_are_conservative() {
-        let sewing = Sewing { pairs: vec![[0, 1]], anchors: vec![(2, DVec3::new(0.1, 0.2, 0.3))], stiffness: 40.0 };
         let x = vec![DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.05, -0.02, 0.01), DVec3::new(0.2, 0.1, 0.0)];
-        let mut f = vec![DVec3::ZERO; 3];
-        sewing.add_forces(&x, &mut f);
-        let e = 1e-6;
-        for v in 0..3 {
-            for axis in 0..3 {
-                let (mut plus, mut minus) = (x.clone(), x.clone());
-                plus[v][axis] += e;
-                minus[v][axis] -= e;
-                let derivative = (sewing.energy(&plus) - sewing.energy(&minus)) / (2.0 * e);
-                assert!((derivative + f[v][axis]).abs() < 1e-6, "vertex {v} axis {axis}");
+        let mut sewing = Sewing { pairs: vec![[0, 1]], anchors: vec![(2, DVec3::new(0.1, 0.2, 0.3))], stiffness: 40.0, ..Sewing::default() };
+        sewing.start(&x);
+        // Zero-length springs, then springs at 40 % of their starting length.
+        for slack in [0.0, 0.4] {
+            sewing.slack = slack;
+            let mut f = vec![DVec3::ZERO; 3];
+            sewing.add_forces(&x, &mut f);
+            let e = 1e-6;
+            for v in 0..3 {
+                for axis in 0..3 {
+                    let (mut plus, mut minus) = (x.clone(), x.clone());
+                    plus[v][axis] += e;
+                    minus[v][axis] -= e;
+                    let derivative = (sewing.energy(&plus) - sewing.energy(&minus)) / (2.0 * e);
+                    assert!((derivative + f[v][axis]).abs() < 1e-6, "slack {slack}: vertex {v} axis {axis}");
+                    // The Hessian's column: the change of −f over a step along this axis.
+                    let (mut fp, mut fm) = (vec![DVec3::ZERO; 3], vec![DVec3::ZERO; 3]);
+                    sewing.add_forces(&plus, &mut fp);
+                    sewing.add_forces(&minus, &mut fm);
+                    let mut k = BlockCsr::with_pattern(3, [(0, 1)].into_iter());
+                    sewing.add_stiffness(&x, &mut k);
+                    let mut unit = vec![DVec3::ZERO; 3];
+                    unit[v][axis] = 1.0;
+                    let mut hessian_column = vec![DVec3::ZERO; 3];
+                    k.multiply(&unit, &mut hessian_column);
+                    for w in 0..3 {
+                        let column = -(fp[w] - fm[w]) / (2.0 * e);
+                        assert!((column - hessian_column[w]).length() < 1e-5, "slack {slack}: Hessian ({w}, {v}) axis {axis}: {column} vs {}", hessian_column[w]);
+                    }
+                }
             }
         }
+        // A spring shorter than its rest length pulls nothing.
+        sewing.slack = 1.0;
+        let mut f = vec![DVec3::ZERO; 3];
+        sewing.add_forces(&x, &mut f);
+        assert!(f.iter().all(|fi| fi.length() < 1e-15) && sewing.energy(&x) == 0.0);
         assert!((sewing.largest_gap(&x) - x[0].distance(x[1])).abs() < 1e-15);
     }
 }
