@@ -115,6 +115,10 @@ fn cases(quick: bool) -> Vec<Case> {
         // 1 m² cloth onto a sphere over its first 0.4 s (the fall and the wrap), on one thread.
         both(&mut out, "tablecloth, to settling", "tablecloth", vec![], None, None);
         both(&mut out, "sphere-drop, first 0.4 s", "sphere-drop", vec![], Some(0.4), Some(&[1]));
+        // Garments sewn on the form and settled, on both paths, on two threads.
+        for garment in ["skirt-gored-straight", "skirt-gored-bias", "skirt-circle", "shift-dress"] {
+            both(&mut out, &format!("{garment}, to settling"), garment, vec![], None, Some(&[2]));
+        }
         // The same drop on the fast path with the quasi-Newton minimizer
         // (`solver.newton.minimizer`), the step design docs/fast-path.md measured against Newton.
         let quasi_newton = vec!["solver.path=fast".to_string(), "solver.newton.minimizer=quasi-newton".into()];
