@@ -8,6 +8,7 @@
 //! speed-up from one thread to two.
 
 use crate::scene::Metrics;
+use crate::settings::SolverPath;
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use crate::outln;
@@ -89,10 +90,10 @@ fn cases(quick: bool) -> Vec<Case> {
     // Whole runs to a settled cloth, each on the exact path and the fast one, side by side:
     // what a user waits for.
     let both = |out: &mut Vec<Case>, name: &str, preset, overrides: Vec<String>, duration, threads| {
-        for path in PATHS {
+        for path in SolverPath::ALL {
             let mut o = overrides.clone();
-            o.push(format!("solver.path={path}"));
-            out.push(Case { threads, ..case(&format!("{name}, {path}"), preset, o, duration, None) });
+            o.push(path.setting());
+            out.push(Case { threads, ..case(&format!("{name}, {}", path.name()), preset, o, duration, None) });
         }
     };
     let edge = |e: f64| vec![format!("mesh.edge_length={e:.5}")];
@@ -108,7 +109,7 @@ fn cases(quick: bool) -> Vec<Case> {
         for n in [5000.0, 80000.0] {
             let name = format!("cusick-drape ~{} tri, to settling, fast", n as u64);
             let mut o = edge(drape_edge_for(n));
-            o.push("solver.path=fast".into());
+            o.push(SolverPath::Fast.setting());
             out.push(Case { threads: Some(&[2]), ..case(&name, "cusick-drape", o, None, None) });
         }
         // Cloth dropped onto props: the tablecloth to settling, and the peers' drop of a
@@ -121,7 +122,7 @@ fn cases(quick: bool) -> Vec<Case> {
         }
         // The same drop on the fast path with the quasi-Newton minimizer
         // (`solver.newton.minimizer`), the step design docs/fast-path.md measured against Newton.
-        let quasi_newton = vec!["solver.path=fast".to_string(), "solver.newton.minimizer=quasi-newton".into()];
+        let quasi_newton = vec![SolverPath::Fast.setting(), "solver.newton.minimizer=quasi-newton".into()];
         out.push(Case { threads: Some(&[1]), ..case("sphere-drop, first 0.4 s, fast, quasi-newton", "sphere-drop", quasi_newton, Some(0.4), None) });
     }
     // The same window for every size, so that their costs compare: the first two 4 ms
@@ -147,9 +148,6 @@ fn cases(quick: bool) -> Vec<Case> {
     both(&mut out, "swing", "swing", vec![], None, Some(&[1]));
     out
 }
-
-/// The solver paths the whole runs compare (`solver.path`).
-const PATHS: [&str; 2] = ["exact", "fast"];
 
 /// The global preconditioners the drape sizes are run with (`solver.newton.preconditioner`).
 const SOLVERS: [&str; 2] = ["cholesky", "multigrid"];
@@ -190,7 +188,7 @@ fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
         cg_per_newton: m.cg_iterations as f64 / newton.max(1.0),
         peak_memory_mb: m.peak_memory_bytes.map_or(f64::NAN, |b| b as f64) / 1e6,
         paper_cpu_seconds_per_10ms: case.paper,
-        path: if case.overrides.iter().any(|o| o == "solver.path=fast") { "fast" } else { "exact" }.to_string(),
+        path: if case.overrides.contains(&SolverPath::Fast.setting()) { "fast" } else { "exact" }.to_string(),
         drape_coefficient: m.measures.drape().map(|d| d.drape_coefficient),
         nodes: m.measures.drape().map(|d| d.nodes),
         settled: m.settled,

@@ -23,4 +23,5 @@ pub mod physics;
 pub mod reference;
 pub mod render;
 pub mod scene;
+pub mod settings;
 pub mod sim;

@@ -4,7 +4,7 @@ use clap::{Parser, Subcommand};
 use cli::run::{RunLimits, RunOutputs};
 use rosette::app::viewer::ViewerOptions;
 use rosette::render;
-use rosette::scene::preset;
+use rosette::settings::{self as preset, SolverPath};
 use rosette::{errln, outln};
 use std::process::ExitCode;
 
@@ -247,9 +247,6 @@ pub struct ScreenshotArgs {
 /// A day: longer than any bundled scene takes, short enough that a runaway run ends.
 pub const DEFAULT_MAX_WALL: f64 = 86_400.0;
 
-/// What `--fast` adds to a scene's overrides.
-const FAST_PATH: &str = "solver.path=fast";
-
 fn main() -> ExitCode {
     let code = dispatch(Cli::parse());
     // Standard output that failed (a full disk; a closed pipe is no failure) is an output
@@ -285,7 +282,7 @@ fn dispatch(cli: Cli) -> ExitCode {
         None => view(ViewerOptions { preset: None, quit_after_frames: cli.quit_after_frames, overrides: Vec::new() }),
         Some(Command::View { preset, quit_after_frames, mut overrides, fast }) => {
             if fast {
-                overrides.push(FAST_PATH.to_string());
+                overrides.push(SolverPath::Fast.setting());
             }
             view(ViewerOptions { preset, quit_after_frames, overrides })
         }
@@ -308,7 +305,7 @@ fn dispatch(cli: Cli) -> ExitCode {
         },
         Some(Command::Run { preset, mut overrides, duration, metrics, outline, step_log, max_steps, max_wall, fast, plan, export, export_frames, force, screenshot }) => {
             if fast {
-                overrides.push(FAST_PATH.to_string());
+                overrides.push(SolverPath::Fast.setting());
             }
             if plan {
                 return cli::run::print_plan(&preset, &overrides, duration);

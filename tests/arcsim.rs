@@ -331,7 +331,7 @@ fn every_material_survives_the_round_trip_through_both_formats() {
 /// second export writes the same file.
 #[test]
 fn every_bundled_fabric_survives_the_round_trip_through_both_formats() {
-    for b in rosette::scene::preset::FABRICS {
+    for b in rosette::settings::FABRICS {
         let f = fabric(&load_fabric(b.name).unwrap());
         let exported = written(&export(&f).unwrap());
         let back = fabric(&import(&exported));

@@ -3,7 +3,7 @@
 //! the explicit limit 2/ω_max computed from each model: symplectic Euler diverges above it
 //! and stays bounded below it, while the implicit integrators stay bounded at those steps.
 
-use rosette::scene::levels::SolverPath;
+use rosette::settings::SolverPath;
 use rosette::chart::{ChartOptions, INACCURATE_ERROR, Plan, Problem, Progress, Status};
 use rosette::sim::IntegratorKind;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! scene with complete metrics, exit codes and messages for bad input (2) and divergence (3),
 //! and metrics on standard output.
 
-use rosette::scene::preset::SCENES;
+use rosette::settings::SCENES;
 use rosette::scene::{Metrics, Scene, load_scene};
 use serde_json::Value;
 use std::path::PathBuf;

@@ -78,7 +78,7 @@ fn list_names_every_bundled_fabric_and_its_sheet() {
     let out = rosette(&["fabric", "list"]);
     assert!(out.status.success());
     let listed = text(&out.stdout);
-    for b in rosette::scene::preset::FABRICS {
+    for b in rosette::settings::FABRICS {
         assert!(listed.lines().any(|l| l.starts_with(b.name)), "{}: {listed}", b.name);
     }
     assert!(listed.lines().any(|l| l.starts_with("wool-plain-fast") && l.contains("fast")), "{listed}");

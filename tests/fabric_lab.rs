@@ -7,7 +7,7 @@
 
 use rosette::fabric::{LoadedFabric, load_fabric, parse_fabric};
 use rosette::lab::{ReadBack, readback};
-use rosette::scene::preset::FABRICS;
+use rosette::settings::FABRICS;
 
 /// Reads every sheet value of `fabric` back and prints the table.
 fn check(name: &str, fabric: &LoadedFabric) -> ReadBack {

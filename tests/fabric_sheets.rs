@@ -5,7 +5,7 @@
 
 use rosette::fabric::{Sheets, derive, expand_sheets, load_fabric, parse_fabric, write};
 use rosette::scene::load_scene;
-use rosette::scene::preset::FabricConfig;
+use rosette::settings::FabricConfig;
 
 /// Standard gravity and the gram-force, written out here rather than taken from the
 /// library, so that a wrong factor there cannot agree with itself.

@@ -5,7 +5,8 @@
 
 mod common;
 
-use rosette::scene::{RunOptions, Scene, SceneConfig, load_scene, preset, run_scene};
+use rosette::scene::{RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use rosette::settings as preset;
 
 /// Writes `text` as a scene file and loads it.
 fn load_text(name: &str, text: &str) -> Result<SceneConfig, String> {

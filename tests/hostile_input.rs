@@ -8,7 +8,7 @@
 //! text, arrays of the wrong length); the focused tests below it are the repros,
 //! named after what broke.
 
-use rosette::scene::preset::{FABRICS, SCENES};
+use rosette::settings::{FABRICS, SCENES};
 use serde_json::Value;
 use std::io::Read;
 use std::path::PathBuf;

@@ -10,7 +10,7 @@ mod common;
 
 use common::runtime_dir;
 use rosette::render::{self, BACKGROUND, ColorMap, Frame, Headless, RenderOptions, Screenshot};
-use rosette::scene::preset::SCENES;
+use rosette::settings::SCENES;
 use rosette::scene::{Scene, load_scene};
 use std::collections::HashSet;
 use std::path::PathBuf;

@@ -9,7 +9,7 @@ use rosette::app::plots::{EULER_FORCE_TOP, default_series, euler_points};
 use rosette::app::ui::TESTS;
 use rosette::reference::euler_elastica_from_shortening;
 use rosette::scene::measures::EulerMeasures;
-use rosette::scene::preset::SCENES;
+use rosette::settings::SCENES;
 use rosette::scene::{RunOptions, Scene, load_scene, run_scene};
 
 fn euler_run(overrides: &[&str]) -> EulerMeasures {

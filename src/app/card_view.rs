@@ -3,7 +3,7 @@
 //! shown as the page (an egui texture) and its key numbers, and saved as PNG and JSON.
 
 use crate::card::{Made, Progress};
-use crate::scene::preset::FabricConfig;
+use crate::settings::FabricConfig;
 use egui::Color32;
 use std::sync::Arc;
 use std::thread::JoinHandle;

@@ -7,7 +7,7 @@
 
 use crate::chart::data::{AccuracyRow, StabilityRow, parse_accuracy, parse_stability, read_accuracy, read_stability};
 use crate::chart::{ChartError, ChartOptions, ChartReport, Plan, Problem, Progress, StabilityMap, Status};
-use crate::scene::levels::SolverPath;
+use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use egui::Color32;
 use egui_plot::{GridMark, Legend, Line, MarkerShape, Plot, PlotPoints, Points};

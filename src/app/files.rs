@@ -2,7 +2,7 @@
 //! test data as CSV. Plain functions from data to text (the dialogs live in `dialogs`), so
 //! tests check the formats without a window.
 
-use crate::scene::preset::FabricConfig;
+use crate::settings::FabricConfig;
 use crate::scene::{Measures, SceneConfig};
 use glam::{DVec2, DVec3};
 use std::fmt::Write;

@@ -10,9 +10,9 @@ use super::pin::Pinned;
 use super::colour::ColourMap;
 use super::plots::{self, History};
 use super::worker::{Command, Snapshot};
-use crate::scene::preset::{FABRICS, FabricConfig, SCENES, scene_descriptions};
+use crate::settings::{FABRICS, FabricConfig, SCENES, scene_descriptions};
 use crate::scene::load_scene;
-use crate::scene::levels::SolverPath;
+use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use egui::{Color32, Key, PointerButton, Rect, Sense};
 use egui_plot::{Legend, Line, MarkerShape, Plot, PlotPoints, Points};
@@ -31,6 +31,16 @@ const FABRIC_THROTTLE: Duration = Duration::from_millis(250);
 #[derive(Debug, Clone)]
 pub enum Action {
     Send(Command),
+    /// A file to pick, then read or write.
+    File(FileDialog),
+    Screenshot,
+    /// Keep the current fabric's picture and measures beside the live view.
+    Pin,
+}
+
+/// What a file dialog is opened for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileDialog {
     OpenScene,
     SaveScene,
     OpenFabric,
@@ -39,9 +49,6 @@ pub enum Action {
     ExportCsv,
     /// The cloth as it is now, as glTF binary (`crate::export`).
     ExportGltf,
-    Screenshot,
-    /// Keep the current fabric's picture and measures beside the live view.
-    Pin,
 }
 
 /// A cloth point held by the mouse: it moves in the plane through the picked point facing
@@ -175,13 +182,13 @@ impl ViewerUi {
         ui.horizontal_wrapped(|ui| {
             ui.menu_button("File", |ui| {
                 for (label, action) in [
-                    ("Open scene…", Action::OpenScene),
-                    ("Save scene…", Action::SaveScene),
-                    ("Open fabric…", Action::OpenFabric),
-                    ("Save fabric…", Action::SaveFabric),
-                    ("Export cloth mesh (OBJ)…", Action::ExportObj),
-                    ("Export glTF (GLB, Blender, web)…", Action::ExportGltf),
-                    ("Export test data (CSV)…", Action::ExportCsv),
+                    ("Open scene…", Action::File(FileDialog::OpenScene)),
+                    ("Save scene…", Action::File(FileDialog::SaveScene)),
+                    ("Open fabric…", Action::File(FileDialog::OpenFabric)),
+                    ("Save fabric…", Action::File(FileDialog::SaveFabric)),
+                    ("Export cloth mesh (OBJ)…", Action::File(FileDialog::ExportObj)),
+                    ("Export glTF (GLB, Blender, web)…", Action::File(FileDialog::ExportGltf)),
+                    ("Export test data (CSV)…", Action::File(FileDialog::ExportCsv)),
                     ("Save screenshot (PNG)  F12", Action::Screenshot),
                 ] {
                     if ui.button(label).clicked() {
@@ -461,7 +468,7 @@ impl ViewerUi {
             plots::history_plot(ui, &self.history, &self.history_choice);
         }
         if ui.button("Export test data (CSV)…").clicked() {
-            actions.push(Action::ExportCsv);
+            actions.push(Action::File(FileDialog::ExportCsv));
         }
         egui::CollapsingHeader::new("All measures (JSON)").show(ui, |ui| {
             let mut text = serde_json::to_string_pretty(&*snapshot.measures).unwrap_or_default();

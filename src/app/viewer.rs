@@ -8,10 +8,10 @@
 use super::colour::{self, ColourMap};
 use super::files;
 use crate::render::{self, ColorMap, Frame, PropMesh, RenderOptions, ScalarField};
-use super::ui::{Action, ViewerUi};
+use super::ui::{Action, FileDialog, ViewerUi};
 use super::worker::{Command, Snapshot, Worker};
 use crate::scene::load_scene;
-use crate::scene::preset::SCENES;
+use crate::settings::SCENES;
 use anyhow::{Context, anyhow};
 use egui_wgpu::wgpu;
 use std::path::{Path, PathBuf};
@@ -101,18 +101,6 @@ fn scene_label(spec: &str) -> String {
     Path::new(spec).file_stem().map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into_owned())
 }
 
-/// What a file dialog was opened for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum DialogKind {
-    OpenScene,
-    SaveScene,
-    OpenFabric,
-    SaveFabric,
-    ExportObj,
-    ExportCsv,
-    ExportGltf,
-}
-
 /// GPU state that exists while the window does.
 struct Gpu {
     window: Arc<Window>,
@@ -139,8 +127,8 @@ struct App {
     /// An error that ended the viewer (no usable GPU, no window).
     fatal: Option<anyhow::Error>,
     proxy: EventLoopProxy<Wake>,
-    dialog_tx: Sender<(DialogKind, Option<PathBuf>)>,
-    dialog_rx: Receiver<(DialogKind, Option<PathBuf>)>,
+    dialog_tx: Sender<(FileDialog, Option<PathBuf>)>,
+    dialog_rx: Receiver<(FileDialog, Option<PathBuf>)>,
     dialog_open: bool,
     /// Where the next frame is to be saved as PNG.
     screenshot: Option<PathBuf>,
@@ -337,13 +325,7 @@ impl App {
                 self.pin(snapshot);
                 return;
             }
-            Action::OpenScene => DialogKind::OpenScene,
-            Action::SaveScene => DialogKind::SaveScene,
-            Action::OpenFabric => DialogKind::OpenFabric,
-            Action::SaveFabric => DialogKind::SaveFabric,
-            Action::ExportObj => DialogKind::ExportObj,
-            Action::ExportCsv => DialogKind::ExportCsv,
-            Action::ExportGltf => DialogKind::ExportGltf,
+            Action::File(dialog) => dialog,
         };
         self.open_dialog(dialog, &snapshot.scene_name);
     }
@@ -365,7 +347,7 @@ impl App {
     }
 
     /// Opens a file dialog on its own thread, so the window keeps drawing while it is open.
-    fn open_dialog(&mut self, kind: DialogKind, scene: &str) {
+    fn open_dialog(&mut self, kind: FileDialog, scene: &str) {
         if self.dialog_open {
             return;
         }
@@ -374,15 +356,15 @@ impl App {
         let scene = scene.to_string();
         let spawned = std::thread::Builder::new().name("rosette-dialog".into()).spawn(move || {
             let (filter, extension): (&str, &str) = match kind {
-                DialogKind::OpenScene | DialogKind::SaveScene => ("scene", "toml"),
-                DialogKind::OpenFabric | DialogKind::SaveFabric => ("fabric", "toml"),
-                DialogKind::ExportObj => ("Wavefront OBJ", "obj"),
-                DialogKind::ExportCsv => ("CSV", "csv"),
-                DialogKind::ExportGltf => ("glTF binary", "glb"),
+                FileDialog::OpenScene | FileDialog::SaveScene => ("scene", "toml"),
+                FileDialog::OpenFabric | FileDialog::SaveFabric => ("fabric", "toml"),
+                FileDialog::ExportObj => ("Wavefront OBJ", "obj"),
+                FileDialog::ExportCsv => ("CSV", "csv"),
+                FileDialog::ExportGltf => ("glTF binary", "glb"),
             };
             let dialog = rfd::FileDialog::new().add_filter(filter, &[extension]);
             let path = match kind {
-                DialogKind::OpenScene | DialogKind::OpenFabric => dialog.pick_file(),
+                FileDialog::OpenScene | FileDialog::OpenFabric => dialog.pick_file(),
                 _ => dialog.set_file_name(format!("{scene}.{extension}")).save_file(),
             };
             let _ = tx.send((kind, path));
@@ -404,25 +386,25 @@ impl App {
         }
     }
 
-    fn file_action(&mut self, kind: DialogKind, path: &Path) -> Result<(), String> {
+    fn file_action(&mut self, kind: FileDialog, path: &Path) -> Result<(), String> {
         let snapshot = self.worker.latest();
         let write = |text: String| crate::io::write::whole(path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()));
         match kind {
-            DialogKind::OpenScene => {
+            FileDialog::OpenScene => {
                 let spec = path.to_string_lossy().into_owned();
                 let (config, _) = load_scene(&spec, &[]).map_err(|e| e.to_string())?;
                 self.worker.send(Command::LoadScene { name: scene_label(&spec), config: Box::new(config) });
                 return Ok(());
             }
-            DialogKind::SaveScene => write(files::scene_toml(&snapshot.config)?)?,
-            DialogKind::OpenFabric => {
+            FileDialog::SaveScene => write(files::scene_toml(&snapshot.config)?)?,
+            FileDialog::OpenFabric => {
                 self.ui.set_fabric(files::read_fabric(path)?);
                 return Ok(());
             }
-            DialogKind::SaveFabric => write(files::fabric_toml(&snapshot.config.fabric)?)?,
-            DialogKind::ExportObj => write(files::mesh_obj(&snapshot.positions, &snapshot.rest, &snapshot.triangles))?,
-            DialogKind::ExportCsv => write(files::measures_csv(&snapshot.measures, &self.ui.history.names, &self.ui.history.rows))?,
-            DialogKind::ExportGltf => {
+            FileDialog::SaveFabric => write(files::fabric_toml(&snapshot.config.fabric)?)?,
+            FileDialog::ExportObj => write(files::mesh_obj(&snapshot.positions, &snapshot.rest, &snapshot.triangles))?,
+            FileDialog::ExportCsv => write(files::measures_csv(&snapshot.measures, &self.ui.history.names, &self.ui.history.rows))?,
+            FileDialog::ExportGltf => {
                 let cloth = crate::export::Cloth {
                     triangles: &snapshot.triangles,
                     rest: &snapshot.rest,

@@ -12,8 +12,9 @@
 //! time follows wall time, and when it is slower it runs flat out and reports the
 //! real-time factor. Nothing here depends on a GUI crate, so tests drive it directly.
 
-use crate::scene::{Measures, Scene, SceneConfig, SettleWatch, load_scene, preset::FabricConfig};
-use crate::scene::levels::SolverPath;
+use crate::scene::{Measures, Scene, SceneConfig, SettleWatch, load_scene};
+use crate::settings::FabricConfig;
+use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use glam::DVec3;
 use std::collections::VecDeque;

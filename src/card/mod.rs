@@ -76,7 +76,7 @@ impl Made {
 /// be rendered (no graphics adapter) leaves a note on the page and in `picture_error`; the
 /// numbers are all there. The cost covers the tests, the pictures and the page.
 pub fn make(
-    fabric: &crate::scene::preset::FabricConfig,
+    fabric: &crate::settings::FabricConfig,
     source: &str,
     sheets: Option<(&crate::fabric::Sheets, &crate::fabric::Import)>,
     progress: &Progress,

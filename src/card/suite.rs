@@ -2,12 +2,12 @@
 //! first (it is the longest), then the card's numbers from their results.
 
 use super::{Bending, Cantilever, Card, CardError, Cost, Curve, Drape, DrapeResult, FabricInfo, Progress, Shear, SheetValue, Tensile};
-use crate::fabric::import::{Import, KES_FM};
+use crate::fabric::derived::{Import, KES_FM};
 use crate::fabric::sheet::Sheets;
 use crate::fabric::units::GF_CM_PER_CM;
 use crate::lab::{self, CantileverTest, Direction, KesTensile, LabRuns, PureBending, ShearTest, TensilePull};
 use crate::physics::{bending_length, weight_per_area};
-use crate::scene::preset::{FabricConfig, SCENES};
+use crate::settings::{FabricConfig, SCENES};
 use crate::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 use crate::sim::BendingStiffness;
 use std::time::Instant;

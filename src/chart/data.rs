@@ -3,7 +3,7 @@
 
 use super::sweep::{Case, Outcome, Problem, Status};
 use super::{ChartError, StabilityMap};
-use crate::scene::levels::SolverPath;
+use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use std::fmt::Write as _;
 use std::path::Path;

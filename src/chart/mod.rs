@@ -13,7 +13,7 @@ pub mod sweep;
 pub use data::{AccuracyRow, StabilityRow};
 pub use sweep::{Case, INACCURATE_ERROR, Outcome, Problem, Status, Step};
 
-use crate::scene::levels::SolverPath;
+use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};

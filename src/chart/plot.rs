@@ -5,7 +5,7 @@
 use super::data::{AccuracyRow, StabilityRow};
 use super::sweep::{Problem, Status};
 use super::StabilityMap;
-use crate::scene::levels::SolverPath;
+use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use plotters::coord::Shift;
 use plotters::prelude::*;

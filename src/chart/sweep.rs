@@ -5,7 +5,7 @@
 use crate::reference::{euler_elastica_from_shortening, heavy_cantilever};
 use crate::physics::{cantilever_lambda, weight_per_area};
 use crate::scene::{Measures, RunOptions, Scene, SceneConfig, load_scene, run_scene};
-use crate::scene::levels::SolverPath;
+use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use glam::DVec3;
 

@@ -22,7 +22,7 @@ pub fn template(standard: Option<&str>) -> ExitCode {
 }
 
 pub fn list() -> ExitCode {
-    for b in rosette::scene::preset::FABRICS {
+    for b in rosette::settings::FABRICS {
         match rosette::fabric::parse_fabric(b.text, b.name) {
             Ok(f) => {
                 let mut sheets: Vec<&str> = f.sheets.sections().map(|s| s.kind.section()).collect();

@@ -8,7 +8,7 @@ use rosette::io::guard::Plan;
 use rosette::io::number::short;
 use rosette::io::write::Output;
 use rosette::scene::plan::RunPlan;
-use rosette::scene::preset::{RunFlags, load_scene_with};
+use rosette::scene::{RunFlags, load_scene_with};
 use rosette::scene::{RunOptions, Scene, SceneConfig, StepRecord, possible, run_scene};
 use rosette::{errln, outln, render};
 use std::io::{IsTerminal, Write};

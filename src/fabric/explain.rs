@@ -2,7 +2,7 @@
 //! wrote `kes.LT_warp = 0.001`, not `fabric.tensile_warp`, and a default the sheet never
 //! set (`poisson_warp`) is not the value to blame.
 
-use super::import::Import;
+use super::derived::Import;
 
 /// The keys a fabric check weighs together: the Poisson ratio is refused against the
 /// tensile curves, the bias rigidity against the warp and weft rigidities.

@@ -11,6 +11,7 @@
 
 pub mod arcsim;
 pub mod bias;
+pub mod derived;
 pub mod explain;
 pub mod import;
 pub mod sheet;
@@ -18,10 +19,12 @@ pub mod tensile;
 pub mod units;
 pub mod write;
 
-pub use import::{Derived, Import, derive, expand_sheets, merge_scene_sheets};
+pub use derived::{Derived, Import};
+pub use import::{derive, expand_sheets, merge_scene_sheets};
 pub use sheet::{SheetError, SheetKind, Sheets};
 
-use crate::scene::preset::{FABRICS, FabricConfig};
+use crate::settings::read::{PresetError, PresetKind, read_preset, refuse_fabric_preset};
+use crate::settings::FabricConfig;
 use thiserror::Error;
 
 /// A fabric file read with its sheets: the fabric, and what it came from.
@@ -37,26 +40,26 @@ pub struct LoadedFabric {
     pub warnings: Vec<String>,
 }
 
+/// Why a fabric could not be loaded: the file could not be read or parsed (the settings
+/// layer's refusal), or its sheets or keys are wrong.
 #[derive(Debug, Error)]
 pub enum LoadError {
-    #[error("{source}")]
-    Read { source: crate::io::read::ReadError },
-    #[error("no bundled fabric named '{name}' and no such file; bundled fabrics: {available}")]
-    Unknown { name: String, available: String },
-    #[error("{file}: {message}")]
-    Syntax { file: String, message: String },
+    #[error(transparent)]
+    Preset(#[from] PresetError),
     #[error("{file}: {source}")]
     Sheet { file: String, source: Box<SheetError> },
-    #[error("{file}: {message}")]
-    Invalid { file: String, message: String },
+}
+
+fn invalid(file: &str, message: String) -> LoadError {
+    LoadError::Preset(PresetError::Invalid { file: file.into(), message })
 }
 
 /// Reads a fabric file's text: sheets converted, keys checked.
 pub fn parse_fabric(text: &str, file: &str) -> Result<LoadedFabric, LoadError> {
     // A file's contents are quoted only where it is named as a fabric file (FILE.toml).
     let table = crate::io::read::parse_toml(text, Some(std::path::Path::new(file)), crate::io::read::FileKind::Fabric)
-        .map_err(|message| LoadError::Syntax { file: file.into(), message })?;
-    crate::scene::preset::refuse_fabric_preset(&table).map_err(|message| LoadError::Invalid { file: file.into(), message })?;
+        .map_err(|message| PresetError::Syntax { file: file.into(), message })?;
+    refuse_fabric_preset(&table).map_err(|message| invalid(file, message))?;
     from_table(table, file)
 }
 
@@ -67,40 +70,17 @@ fn from_table(mut table: toml::Table, file: &str) -> Result<LoadedFabric, LoadEr
     let import = if sheets.is_empty() { Import::default() } else { derive(&sheets, &table).map_err(sheet_error)? };
     let warnings = import::apply(&mut table, &import);
     let config: FabricConfig =
-        table.try_into().map_err(|e: toml::de::Error| LoadError::Invalid { file: file.into(), message: e.message().trim().into() })?;
+        table.try_into().map_err(|e: toml::de::Error| invalid(file, e.message().trim().into()))?;
     config.to_fabric().map_err(|e| {
         let message = explain::explain(&import, e.key(), &e.to_string()).map_or_else(|| e.to_string(), |(text, _)| text);
-        LoadError::Invalid { file: file.into(), message }
+        invalid(file, message)
     })?;
     Ok(LoadedFabric { file: file.into(), config, sheets, import, warnings })
-}
-
-/// Whether `spec` names an ARCSim material file (`….json`) rather than a fabric file.
-pub fn is_arcsim_file(spec: &str) -> bool {
-    std::path::Path::new(spec).extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
-}
-
-/// An ARCSim material file read as a fabric: the file is the fabric's `[arcsim]` section
-/// (`data = "FILE"`), named after the file.
-fn load_arcsim(spec: &str) -> Result<LoadedFabric, LoadError> {
-    from_table(crate::scene::preset::arcsim_fabric_table(spec), spec)
 }
 
 /// Loads a bundled fabric by name (`wool`), a fabric file by path, or an ARCSim material
 /// file (`….json`).
 pub fn load_fabric(spec: &str) -> Result<LoadedFabric, LoadError> {
-    if is_arcsim_file(spec) {
-        return load_arcsim(spec);
-    }
-    let is_path = spec.contains('/') || spec.contains('\\') || spec.ends_with(".toml");
-    if !is_path && let Some(b) = FABRICS.iter().find(|b| b.name == spec) {
-        return parse_fabric(b.text, &format!("presets/fabrics/{}.toml (bundled)", b.name));
-    }
-    let path = std::path::Path::new(spec);
-    if !path.exists() && !is_path {
-        let available = FABRICS.iter().map(|b| b.name).collect::<Vec<_>>().join(", ");
-        return Err(LoadError::Unknown { name: spec.into(), available });
-    }
-    let text = crate::io::read::read_text(path, crate::io::read::FileKind::Fabric).map_err(|source| LoadError::Read { source })?;
-    parse_fabric(&text, spec)
+    let (table, file) = read_preset(PresetKind::Fabric, spec, None, None)?;
+    from_table(table, &file)
 }

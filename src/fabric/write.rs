@@ -1,7 +1,7 @@
 //! Text a designer reads: the fabric file `rosette fabric import` writes, with every
 //! value's source, and the sheet template `rosette fabric template` prints.
 
-use super::import::Import;
+use super::derived::Import;
 use super::sheet::{SheetKind, Sheets, TEXT_FIELDS, Use};
 
 /// Units of the fabric keys, for the comments beside them.

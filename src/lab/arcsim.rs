@@ -14,13 +14,13 @@
 //! (their own curvature samples) and ARCSim's own KES shear slope (its shear stiffens with
 //! strain).
 
-use super::readback::{Property, ReadBack};
+use super::report::{Property, ReadBack};
 use super::{Direction, LabError, Strip, bend_to, load_at, shear, strain_pull};
 use crate::fabric::arcsim::ArcsimMaterial;
 use crate::fabric::arcsim::model::{BIAS_ROW, HINGE_FACTOR, STRAIN_SAMPLE, WARP_ROW, WEFT_ROW, moment, sample_curvatures, stiffness, uniaxial};
 use crate::fabric::arcsim::project::{MAX_POISSON, warp_bending_curve, zero_strain_plate};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
-use crate::scene::preset::FabricConfig;
+use crate::settings::FabricConfig;
 
 /// Strains the axis pulls are read at: small, between the samples, the strain sample.
 pub const PULL_STRAINS: [f64; 3] = [0.02, STRAIN_SAMPLE / 2.0, STRAIN_SAMPLE];

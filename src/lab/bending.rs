@@ -2,7 +2,7 @@
 
 use super::{Direction, LabError, measure, run, scene_config};
 use crate::fabric::units::GF_CM2_PER_CM;
-use crate::scene::preset::FabricConfig;
+use crate::settings::FabricConfig;
 
 /// The curvatures KES-FB2 reads its slope between, 1/m (0.5 and 1.5 cm⁻¹).
 pub const KES_CURVATURES: [f64; 2] = [50.0, 150.0];

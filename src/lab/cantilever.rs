@@ -3,7 +3,7 @@
 use super::{Direction, LabError, measure, run, scene_config};
 use crate::fabric::bias::STANDARD_CHORD_ANGLE_DEG;
 use crate::physics::{bending_length, weight_per_area};
-use crate::scene::preset::FabricConfig;
+use crate::settings::FabricConfig;
 
 /// What the virtual cantilever test reports.
 #[derive(Debug, Clone, PartialEq)]

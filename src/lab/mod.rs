@@ -20,16 +20,18 @@ pub mod arcsim;
 mod bending;
 mod cantilever;
 pub mod readback;
+pub mod report;
 mod shear;
 mod tensile;
 
 pub use bending::{PureBending, bend_to, pure_bending};
 pub use cantilever::{CantileverTest, cantilever_bending_length};
-pub use readback::{LabRuns, Property, ReadBack, readback, readback_with};
+pub use readback::{LabRuns, readback, readback_with};
+pub use report::{Property, ReadBack};
 pub use shear::{ShearTest, shear};
 pub use tensile::{KesTensile, Strip, TensilePull, kes_tensile, load_at, strain_pull, tensile_pull};
 
-use crate::scene::preset::FabricConfig;
+use crate::settings::FabricConfig;
 use crate::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 use thiserror::Error;
 

@@ -3,84 +3,13 @@
 
 use super::{CantileverTest, Direction, KesTensile, LabError, PureBending, ShearTest, cantilever_bending_length, kes_tensile, pure_bending, shear};
 use crate::fabric::bias::STANDARD_STRIP_WIDTH;
-use crate::fabric::import::{FAST_SHEAR_CONSTANT, Import, KES_FM};
+use crate::fabric::derived::{DEFAULT_LT, FAST_SHEAR_CONSTANT, Import, KES_FM};
 use crate::fabric::sheet::{SheetKind, Sheets};
 use crate::fabric::tensile::FAST_LOADS;
 use crate::fabric::units::{GF_CM_PER_CM2, GF_CM2_PER_CM, GF_PER_CM_DEG};
-use crate::scene::preset::FabricConfig;
+use crate::settings::FabricConfig;
+use super::report::{Property, ReadBack};
 use std::collections::BTreeMap;
-
-/// One property of a sheet and its virtual reading, both in the sheet's unit.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Property {
-    /// The sheet field, e.g. `kes.EMT_warp`.
-    pub field: String,
-    pub unit: &'static str,
-    /// What the sheet says (computed by the standard's formula where the sheet gives the
-    /// property through others, e.g. WT = LT·Fm·EMT/2).
-    pub sheet: f64,
-    /// What the virtual test read.
-    pub measured: f64,
-    /// The test that read it.
-    pub test: &'static str,
-    /// Relative tolerance the round trip is held to (issue 26: tensile 3 %, bending 2 %,
-    /// shear 5 %, bending lengths 3 %).
-    pub tolerance: f64,
-    /// Why a value is read and reported but not held to the tolerance (an ARCSim sample
-    /// the projection drops); None for a value held.
-    pub unheld: Option<String>,
-}
-
-impl Property {
-    /// (measured − sheet)/sheet.
-    pub fn error(&self) -> f64 {
-        (self.measured - self.sheet) / self.sheet
-    }
-
-    pub fn passes(&self) -> bool {
-        self.unheld.is_some() || self.error().abs() <= self.tolerance
-    }
-
-    /// Whether the value is held to its tolerance.
-    pub fn held(&self) -> bool {
-        self.unheld.is_none()
-    }
-}
-
-/// Every sheet property that the fabric's keys came from, read back.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ReadBack {
-    pub properties: Vec<Property>,
-}
-
-impl ReadBack {
-    pub fn all_pass(&self) -> bool {
-        self.properties.iter().all(Property::passes)
-    }
-
-    /// A plain-text table: field, sheet, virtual, error, tolerance.
-    pub fn table(&self) -> String {
-        let mut out = format!("{:<22} {:>12} {:>12} {:>8} {:>6}  {}\n", "sheet field", "sheet", "virtual", "error", "tol.", "unit (test)");
-        for p in &self.properties {
-            let tolerance = if p.held() { format!("{:>5.0}%", 100.0 * p.tolerance) } else { "    -".into() };
-            let flag = match (&p.unheld, p.passes()) {
-                (Some(why), _) => format!("  not held: {why}"),
-                (None, true) => String::new(),
-                (None, false) => "  OUTSIDE".into(),
-            };
-            out += &format!(
-                "{:<22} {:>12.5} {:>12.5} {:>+7.2}% {tolerance}  {} ({}){flag}\n",
-                p.field,
-                p.sheet,
-                p.measured,
-                100.0 * p.error(),
-                p.unit,
-                p.test,
-            );
-        }
-        out
-    }
-}
 
 /// Virtual tests already run on the fabric, handed to [`readback_with`] so that it reads
 /// them instead of running them again (the fabric card runs them all in parallel first).
@@ -165,7 +94,7 @@ pub fn readback_with(sheets: &Sheets, import: &Import, fabric: &FabricConfig, do
                     (Some(e), Some(l), w) => (e, l, w.unwrap_or(l * fm * e / 2.0)),
                     (Some(e), None, Some(w)) => (e, w / (fm * e / 2.0), w),
                     (None, Some(l), Some(w)) => (2.0 * w / (l * fm), l, w),
-                    (Some(e), None, None) => (e, crate::fabric::import::DEFAULT_LT, crate::fabric::import::DEFAULT_LT * fm * e / 2.0),
+                    (Some(e), None, None) => (e, DEFAULT_LT, DEFAULT_LT * fm * e / 2.0),
                     _ => continue,
                 };
                 let t = runs.tensile(d)?;

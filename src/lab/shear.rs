@@ -3,7 +3,7 @@
 use super::{LabError, scene_config};
 use crate::fabric::units::GF_PER_CM_DEG;
 use crate::scene::Scene;
-use crate::scene::preset::{FabricConfig, ShearKinematics};
+use crate::settings::{FabricConfig, ShearKinematics};
 use glam::DVec3;
 
 /// The angles KES-FB1 reads its shear slope between, degrees.

@@ -3,7 +3,7 @@
 use super::{Direction, LabError, scene_config};
 use crate::fabric::units::{GF_CM_PER_CM2, GF_PER_CM};
 use crate::scene::Scene;
-use crate::scene::preset::FabricConfig;
+use crate::settings::FabricConfig;
 use crate::scene::strip::Columns;
 use glam::DVec3;
 

@@ -25,62 +25,6 @@
 use super::run::SettleWatch;
 use super::Scene;
 use crate::sim::Mesh;
-use serde::{Deserialize, Serialize};
-
-/// Which step design a scene runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum SolverPath {
-    /// The validated reference: the scene's own mesh and time step from start to end.
-    #[default]
-    Exact,
-    /// Model no more of the path than the result needs: drapes settle coarse to fine at the
-    /// fast path's time step (see the module documentation).
-    Fast,
-}
-
-impl SolverPath {
-    pub const ALL: [SolverPath; 2] = [SolverPath::Exact, SolverPath::Fast];
-
-    /// The name as typed in scene files and CSV tables.
-    pub fn name(self) -> &'static str {
-        match self {
-            SolverPath::Exact => "exact",
-            SolverPath::Fast => "fast",
-        }
-    }
-
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|p| p.name() == name)
-    }
-}
-
-/// Settings of the fast path (`[solver.fast]`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct FastSettings {
-    /// Time step of the levels that resolve the folds of a slowly loaded cloth, s.
-    pub dt: f64,
-    /// Time step of a cloth dropped onto props, s: shorter than `dt`, since the folds a
-    /// falling cloth lands in depend on the fall's path, which long steps damp and change
-    /// (docs/fast-path.md: with every Newton solve converged the tablecloth's coefficient
-    /// came out 0.23–0.26 at 32 ms against the exact path's 0.066–0.146 over eight seeds,
-    /// and 0.129–0.141 at 16 ms over seeds 1–3).
-    pub drop_dt: f64,
-    /// Largest edge of the coarsest level as a share of the fabric's bending length
-    /// (B/w)^(1/3): coarse enough to be cheap, fine enough that folds, whose width scales
-    /// with the bending length, span several elements.
-    pub coarsest_edge_share: f64,
-    /// Newton stops at a step under this share of the step's own integration error
-    /// (`solver.newton.error_share`; the exact path's tolerance still holds at rest).
-    pub error_share: f64,
-}
-
-impl Default for FastSettings {
-    fn default() -> Self {
-        Self { dt: 0.064, drop_dt: 0.016, coarsest_edge_share: 0.5, error_share: 0.1 }
-    }
-}
 
 /// The finer levels still to come and the settling of the current one.
 pub struct Levels {

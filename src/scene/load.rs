@@ -3,7 +3,8 @@
 //! or the flag that gave the value (`Sources`), in the terms the user wrote it in: a sheet's
 //! field rather than the fabric key it became, `--duration` rather than `scene.duration`.
 
-use super::preset::{FABRICS, FabricConfig, PresetError, SCENES, SceneConfig, apply_override, looks_like_path, parse_override, read_table};
+use crate::settings::read::{PresetKind, apply_override, looks_like_path, parse_override, read_preset};
+use crate::settings::{FabricConfig, PresetError, SceneConfig};
 use crate::fabric::Import;
 use crate::io::number::short;
 use std::path::Path;
@@ -152,7 +153,7 @@ pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, Stri
 
 /// [`load_scene`] for a run with `flags` (`rosette run --duration`, `--max-steps`).
 pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Result<(SceneConfig, String), PresetError> {
-    let (mut table, file) = read_table("scene", spec, SCENES, None)?;
+    let (mut table, file) = read_preset(PresetKind::Scene, spec, None, Some("scene"))?;
     let base = if looks_like_path(spec) || Path::new(spec).exists() { Path::new(spec).parent().map(Path::to_path_buf) } else { None };
     let scene_fabric_keys = table.get("fabric").and_then(|v| v.as_table()).map(|t| t.keys().cloned().collect()).unwrap_or_default();
     let mut sources = Sources {
@@ -167,7 +168,7 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
     let mut fabric_table = None;
     // The fabric file named in the scene file, for the original values.
     if let Some(name) = table.get("fabric").and_then(|f| f.get("preset")).and_then(|v| v.as_str()) {
-        let (fabric, fabric_file) = read_table("fabric", name, FABRICS, base.as_deref())?;
+        let (fabric, fabric_file) = read_preset(PresetKind::Fabric, name, base.as_deref(), Some("fabric.preset"))?;
         fabric_table = Some((name.to_string(), fabric, fabric_file));
     }
     sources.original = merge_fabric(table.clone(), fabric_table.as_ref().map(|f| f.1.clone()));
@@ -190,7 +191,7 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
         let name = preset.as_str().ok_or_else(|| sources.invalid(&key_parts("fabric.preset"), format!("fabric.preset must be a fabric name or file in quotes, got {preset}")))?;
         if fabric_table.as_ref().is_none_or(|f| f.0 != name) {
             let (fabric, fabric_file) =
-                read_table("fabric", name, FABRICS, base.as_deref()).map_err(|e| {
+                read_preset(PresetKind::Fabric, name, base.as_deref(), Some("fabric.preset")).map_err(|e| {
                     let message = match e {
                         PresetError::Read { source, .. } => source.to_string(),
                         e => e.to_string(),
@@ -229,7 +230,7 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
         sources.invalid(&parts, type_error(&key, &message, example))
     })?;
     config.base_dir = base;
-    super::validate::check_scene_for(&config, flags.duration).map_err(|e| match (e.key.as_str(), flags.duration) {
+    crate::settings::validate::check_scene_for(&config, flags.duration).map_err(|e| match (e.key.as_str(), flags.duration) {
         ("--duration", Some(d)) => PresetError::Invalid { file: format!("--duration {}", short(d)), message: sources.in_flags(e.message) },
         (key, _) if key.starts_with("fabric.") => sources.fabric_invalid(key, e.message),
         (key, _) => {
@@ -271,3 +272,66 @@ fn merge_fabric(mut table: toml::Table, fabric_file: Option<toml::Table>) -> tom
     table
 }
 
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::settings::read::parse_table;
+    use crate::settings::{FABRICS, SCENES};
+    use crate::sim::IntegratorKind;
+
+    #[test]
+    fn every_bundled_scene_and_fabric_loads() {
+        for s in SCENES {
+            load_scene(s.name, &[]).unwrap_or_else(|e| panic!("{}: {e}", s.name));
+        }
+        for f in FABRICS {
+            let mut t = parse_table(f.text, f.name).unwrap();
+            crate::fabric::expand_sheets(&mut t).unwrap_or_else(|e| panic!("{}: {e}", f.name));
+            let c: FabricConfig = t.try_into().unwrap_or_else(|e| panic!("{}: {e}", f.name));
+            c.to_fabric().unwrap_or_else(|e| panic!("{}: {e}", f.name));
+        }
+    }
+
+    #[test]
+    fn overrides_parse_numbers_arrays_and_bare_strings() {
+        let (config, _) = load_scene(
+            "tensile-warp",
+            &[
+                "fabric.areal_density=0.2".into(),
+                "solver.integrator=bdf2".into(),
+                "fabric.tensile_warp=[[0,0],[0.01,12.5]]".into(),
+                "fabric.preset=denim".into(),
+            ],
+        )
+        .unwrap();
+        assert_eq!(config.fabric.properties.areal_density, 0.2);
+        assert_eq!(config.solver.integrator, IntegratorKind::Bdf2);
+        assert_eq!(config.fabric.properties.tensile_warp, vec![[0.0, 0.0], [0.01, 12.5]]);
+        assert_eq!(config.fabric.preset.as_deref(), Some("denim"));
+        assert!(config.fabric.properties.bending_warp > 5e-5, "denim's rigidity came with the preset switch");
+    }
+
+    #[test]
+    fn bad_input_names_the_key_and_the_fix() {
+        let err = load_scene("tensile-warp", &["fabric.areal_density=-1".into()]).unwrap_err().to_string();
+        assert!(err.contains("fabric.areal_density") && err.contains("positive"), "{err}");
+        let err = load_scene("tensile-warp", &["fabric.densty=1".into()]).unwrap_err().to_string();
+        assert!(err.contains("densty"), "{err}");
+        let err = load_scene("tensile-warp", &["fabric.tensile_warp=[[0,0],[0.02,5],[0.01,9]]".into()]).unwrap_err().to_string();
+        assert!(err.contains("tensile_warp") && err.contains("sort"), "{err}");
+        let err = load_scene("tensile-warp", &["solver.integrator=rk4".into()]).unwrap_err().to_string();
+        assert!(err.contains("rk4") && err.contains("implicit-euler"), "{err}");
+        let err = load_scene("no-such-scene", &[]).unwrap_err().to_string();
+        assert!(err.contains("tensile-warp"), "lists what exists: {err}");
+        let err = load_scene("tensile-warp", &["solver.dt".into()]).unwrap_err().to_string();
+        assert!(err.contains("KEY=VALUE"), "{err}");
+    }
+
+    /// The simulator's tests use the wool suiting written out (`sim::model::tests`); it is
+    /// the bundled file's.
+    #[test]
+    fn the_simulators_wool_is_the_bundled_wool() {
+        let bundled = crate::fabric::load_fabric("wool").unwrap().config.to_fabric().unwrap();
+        assert_eq!(format!("{bundled:?}"), format!("{:?}", crate::sim::model::tests::wool_suiting()));
+    }
+}

@@ -1,5 +1,5 @@
 //! Scenes: a preset turned into a model, an initial state, a test rig and its measurements.
-//! One registry (`preset::SCENES`) feeds the command line, the tests and the viewer.
+//! One registry (`settings::SCENES`) feeds the command line, the tests and the viewer.
 
 pub mod drape;
 pub mod garment;
@@ -7,7 +7,6 @@ pub mod levels;
 pub mod load;
 pub mod measures;
 pub mod memory;
-pub mod preset;
 pub mod possible;
 pub mod props;
 pub mod rigs;
@@ -15,10 +14,10 @@ pub mod run;
 pub mod strip;
 pub mod plan;
 pub mod swing;
-pub mod validate;
 
 pub use measures::Measures;
-pub use preset::{SceneConfig, SceneKind, load_scene};
+pub use crate::settings::{SceneConfig, SceneKind};
+pub use load::{RunFlags, load_scene, load_scene_with};
 pub use run::{ContactEvents, Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
 
 use crate::sim::contact::ContactModel;

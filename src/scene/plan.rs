@@ -16,7 +16,7 @@
 //!              └ a laboratory rig ──────────── Exact (the loading is the experiment)
 //! ```
 
-use super::levels::SolverPath;
+use crate::settings::SolverPath;
 use super::{SceneConfig, SceneError, SceneKind};
 use crate::physics::{bending_length, weight_per_area};
 use crate::sim::PreconditionerChoice;

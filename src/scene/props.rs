@@ -1,21 +1,12 @@
 //! Props from scene files: `[[props]]` tables turned into the simulator's parry3d props,
 //! with OBJ meshes read from the bundled assets or from disk.
 
-use super::preset::{PropConfig, PropKind};
+use crate::settings::{ASSETS, PropConfig, PropKind};
 use crate::sim::contact::{MAX_REACH, Prop, PropShape};
 use glam::{DQuat, DVec3, EulerRot};
 use crate::io::number::short;
 use crate::io::read::{FileKind, quotable, read_text};
 use std::path::{Path, PathBuf};
-
-/// An asset file bundled into the binary.
-pub struct Asset {
-    pub name: &'static str,
-    pub text: &'static str,
-}
-
-/// Bundled meshes, addressed by their path under the repository (`assets/cushion.obj`).
-pub const ASSETS: &[Asset] = &[Asset { name: "assets/cushion.obj", text: include_str!("../../assets/cushion.obj") }];
 
 /// Builds every prop of a scene; errors name the prop and the key to fix.
 pub fn build_props(configs: &[PropConfig], base_dir: Option<&Path>) -> Result<Vec<Prop>, String> {

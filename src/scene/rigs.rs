@@ -1,7 +1,7 @@
 //! Test rigs: how each laboratory test holds and drives the cloth, and what it measures.
 
 use super::measures::{ArcMeasures, CantileverMeasures, DrapeMeasures, EulerMeasures, Measures, ShearMeasures, TensileMeasures};
-use super::preset::ShearKinematics;
+use crate::settings::ShearKinematics;
 use super::strip::{Columns, count_half_waves, fit_circle_radius, group_force, vertices_where};
 use super::{SceneConfig, SceneError, SceneKind, drape};
 use crate::physics::{STANDARD_GRAVITY, bending_length, cantilever_lambda, weight_per_area};
@@ -148,7 +148,7 @@ impl Rig {
                 let fixed = vertices_where(&rest, |p| p.x < ON_EDGE);
                 let moving = vertices_where(&rest, |p| p.x > length - ON_EDGE);
                 let speed = t.speed.expect("checked when loading");
-                let stop = super::possible::motion_time(config).expect("checked when loading").1;
+                let stop = crate::settings::validate::motion_time(config).expect("checked when loading").1;
                 pin_all(model, &fixed);
                 model.drive(&moving, x, Motion::Linear { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop });
                 let columns = Columns::new(&rest, length, h);
@@ -195,7 +195,7 @@ impl Rig {
                 let left = vertices_where(&rest, |p| p.x < ON_EDGE);
                 let right = vertices_where(&rest, |p| p.x > length - ON_EDGE);
                 let speed = t.speed.expect("checked when loading");
-                let stop = super::possible::motion_time(config).expect("checked when loading").1;
+                let stop = crate::settings::validate::motion_time(config).expect("checked when loading").1;
                 // Both ends move, each at half the approach speed, so the midspan stays put.
                 model.drive(&left, x, Motion::Linear { velocity: DVec3::new(0.5 * speed, 0.0, 0.0), start: 0.0, stop });
                 model.drive(&right, x, Motion::Linear { velocity: DVec3::new(-0.5 * speed, 0.0, 0.0), start: 0.0, stop });
@@ -208,7 +208,7 @@ impl Rig {
                 let clamped = vertices_where(&rest, |p| p.y < ON_EDGE);
                 let moving = vertices_where(&rest, |p| p.y > width - ON_EDGE);
                 let speed = t.speed.expect("checked when loading");
-                let stop = super::possible::motion_time(config).expect("checked when loading").1;
+                let stop = crate::settings::validate::motion_time(config).expect("checked when loading").1;
                 pin_all(model, &clamped);
                 let motion = match t.shear_kinematics.unwrap_or_default() {
                     // The moving grip slides along the warp; the gap stays, so the cross yarns stretch.

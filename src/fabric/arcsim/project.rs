@@ -21,7 +21,7 @@
 
 use super::material::ArcsimMaterial;
 use super::model::{BIAS_ROW, CURVATURE_STEP, HINGE_FACTOR, STRAIN_SAMPLE, WARP_ROW, WEFT_ROW, moment, uniaxial};
-use crate::fabric::import::{DEFAULT_BULK_DENSITY, Derived, Import};
+use crate::fabric::derived::{DEFAULT_BULK_DENSITY, Derived, Import};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 
 /// How closely the sampled curves follow ARCSim's, relative, at every strain or curvature

@@ -183,7 +183,7 @@ mod tests {
     use crate::sim::model::PhysicsOptions;
 
     fn fabric() -> Fabric {
-        crate::scene::load_scene("cusick-drape", &[]).unwrap().0.material().unwrap()
+        crate::sim::model::tests::wool_suiting()
     }
 
     /// A smooth, non-developable deformation of the rest plane (bending and stretching).

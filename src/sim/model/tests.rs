@@ -20,6 +20,24 @@ pub(crate) fn test_fabric() -> Fabric {
     }
 }
 
+/// The wool suiting of `presets/fabrics/wool.toml` (the paper's sample), written out so
+/// that the simulator's own tests need no preset loader; `scene::load`'s tests hold the
+/// two equal.
+pub(crate) fn wool_suiting() -> Fabric {
+    Fabric {
+        areal_density: 0.137,
+        thickness: 3.14e-4,
+        tensile_warp: PiecewiseLinear::new_material(&[[0.0, 0.0], [0.005, 5.0], [0.015, 20.0], [0.035, 98.0], [0.060, 490.5]]).unwrap(),
+        tensile_weft: PiecewiseLinear::new_material(&[[0.0, 0.0], [0.006, 4.8], [0.018, 19.2], [0.040, 85.2], [0.070, 445.2]]).unwrap(),
+        shear_modulus: 40.0,
+        poisson_warp: 0.15,
+        bending_warp: 9.0e-6,
+        bending_weft: 7.0e-6,
+        bending_bias: Some(5.6e-6),
+        bending_curve: None,
+    }
+}
+
 fn deformed(model: &Model, f: impl Fn(DVec2) -> DVec3) -> Vec<DVec3> {
     model.rest.iter().map(|&p| f(p)).collect()
 }

@@ -1,5 +1,4 @@
 use super::*;
-use crate::scene::load_scene;
 use crate::sim::linalg::{BlockCsr, Preconditioner, ScalarCsr, pcg};
 use crate::sim::{Fabric, Mesh, Model, Pattern, PhysicsOptions};
 use glam::DVec2;
@@ -57,8 +56,7 @@ fn sparse_product_and_transpose_match_dense_arithmetic() {
 }
 
 fn wool() -> Fabric {
-    let (config, _) = load_scene("tensile-warp", &[]).expect("bundled preset loads");
-    config.fabric.to_fabric().expect("bundled fabric is valid")
+    crate::sim::model::tests::wool_suiting()
 }
 
 /// The Newton matrix at h = 4 ms of a wool sheet `size` m square with edges `edge`,

@@ -6,7 +6,13 @@
 //! it would overflow the arithmetic, break the mesh or make a measure meaningless (a
 //! support larger than the specimen), never merely because it is unusual.
 
-use super::preset::{SceneConfig, SceneKind};
+mod garment;
+mod motion;
+
+pub use garment::MAX_SEWING_STIFFNESS;
+pub use motion::{check_motion_fits, motion_time};
+
+use super::{PropConfig, PropKind, SceneConfig, SceneKind, SolverPath};
 use crate::io::number::short;
 use crate::sim::contact::MAX_REACH;
 use crate::sim::mesh::{MAX_VERTICES, planned_vertices};
@@ -22,20 +28,20 @@ pub struct Invalid {
     pub also: Vec<String>,
 }
 
-pub(super) fn invalid(key: &str, message: String) -> Invalid {
+pub fn invalid(key: &str, message: String) -> Invalid {
     Invalid { key: key.to_string(), message, also: Vec::new() }
 }
 
-pub(super) fn positive(key: &str, v: f64) -> Result<f64, Invalid> {
+pub fn positive(key: &str, v: f64) -> Result<f64, Invalid> {
     if v.is_finite() && v > 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be a positive number, got {}", short(v)))) }
 }
 
-pub(super) fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
+pub fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
     if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be zero or a positive number, got {}", short(v)))) }
 }
 
 /// Positive and at most `max` (`why` says what the bound is).
-pub(super) fn positive_at_most(key: &str, v: f64, max: f64, why: &str) -> Result<f64, Invalid> {
+pub fn positive_at_most(key: &str, v: f64, max: f64, why: &str) -> Result<f64, Invalid> {
     positive(key, v)?;
     if v > max {
         return Err(invalid(key, format!("{key} = {} is more than {} ({why})", short(v), short(max))));
@@ -120,7 +126,7 @@ pub fn check_scene_for(c: &SceneConfig, run_duration: Option<f64>) -> Result<(),
     check_solver(c, &run)?;
     check_step_count(run.key, run.seconds, c.solver.dt, s.max_steps)?;
     let extent = if c.scene.kind == SceneKind::Garment {
-        super::garment::check(c)?
+        garment::check(c)?
     } else {
         let extent = check_cloth(c)?;
         check_mesh(c, &extent)?;
@@ -147,8 +153,7 @@ struct RunLength {
 
 /// Refuses a size key the prop's shape does not read (a sphere's `height` would be
 /// silently ignored).
-fn check_prop_keys(i: usize, p: &super::preset::PropConfig) -> Result<(), Invalid> {
-    use super::preset::PropKind;
+fn check_prop_keys(i: usize, p: &PropConfig) -> Result<(), Invalid> {
     let reads: &[&str] = match p.shape {
         PropKind::Ground => &[],
         PropKind::Box => &["size"],
@@ -204,7 +209,7 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
     let fast = &solver.fast;
     positive("solver.fast.dt", fast.dt)?;
     positive("solver.fast.drop_dt", fast.drop_dt)?;
-    if solver.path == super::levels::SolverPath::Fast {
+    if solver.path == SolverPath::Fast {
         positive_at_most("solver.fast.dt", fast.dt, duration, &format!("{}: the fast path's long step must fit in the run", run.key))?;
         positive_at_most("solver.fast.drop_dt", fast.drop_dt, duration, &format!("{}: a dropped cloth's step must fit in the run", run.key))?;
     }
@@ -406,7 +411,7 @@ fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
     if let Some(v) = t.clamp_length {
         positive_at_most("test.clamp_length", v, length, "the strip's length, cloth.length")?;
     }
-    super::possible::check_motion_fits(c)?;
+    motion::check_motion_fits(c)?;
     if kind == SceneKind::Drape {
         check_support(c, extent)?;
     }

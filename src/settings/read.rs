@@ -1,0 +1,172 @@
+//! The one reader of "a bundled name or a file" for scenes and fabrics, and the `--set`
+//! overrides: every refusal names the file and, where it can, the key.
+
+use super::registry::{Bundled, FABRICS, SCENES};
+use crate::io::read::{FileKind, parse_toml, read_text};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Why a preset could not be loaded. Every message names the file and, where it can, the key.
+#[derive(Debug, Error)]
+pub enum PresetError {
+    #[error("{}{source}", .key.map_or(String::new(), |k| format!("{k}: ")))]
+    Read { key: Option<&'static str>, source: crate::io::read::ReadError },
+    #[error("{file}: {message}")]
+    Syntax { file: String, message: String },
+    #[error("{file}: {message}")]
+    Invalid { file: String, message: String },
+    #[error("no bundled {kind} named '{name}' and no such file; bundled {kind}s: {available}")]
+    Unknown { kind: &'static str, name: String, available: String },
+    #[error("--set {text}: {message}")]
+    BadOverride { text: String, message: String },
+}
+
+/// Whether `spec` reads as a path rather than a bundled name.
+pub fn looks_like_path(spec: &str) -> bool {
+    spec.contains('/') || spec.contains('\\') || spec.ends_with(".toml")
+}
+
+/// Whether `spec` names an ARCSim material file (`….json`) rather than a fabric file.
+pub fn is_arcsim_file(spec: &str) -> bool {
+    Path::new(spec).extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
+}
+
+/// What a name or a path stands for: a scene or a fabric.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PresetKind {
+    Scene,
+    Fabric,
+}
+
+impl PresetKind {
+    fn name(self) -> &'static str {
+        match self {
+            PresetKind::Scene => "scene",
+            PresetKind::Fabric => "fabric",
+        }
+    }
+
+    fn bundled(self) -> &'static [Bundled] {
+        match self {
+            PresetKind::Scene => SCENES,
+            PresetKind::Fabric => FABRICS,
+        }
+    }
+
+    fn file_kind(self) -> FileKind {
+        match self {
+            PresetKind::Scene => FileKind::Scene,
+            PresetKind::Fabric => FileKind::Fabric,
+        }
+    }
+}
+
+/// Reads a bundled preset by name or a file by path (relative to `base` where that holds
+/// it) through the bounded reader, and parses it; returns the table and the name errors
+/// give the file. `key` is the key that named the file, for a read error (`fabric.preset`).
+/// A fabric may be an ARCSim material file, which stands for a fabric table whose
+/// `[arcsim]` section reads it.
+pub fn read_preset(kind: PresetKind, spec: &str, base: Option<&Path>, key: Option<&'static str>) -> Result<(toml::Table, String), PresetError> {
+    let list = kind.bundled();
+    let bundled = list.iter().find(|b| b.name == spec);
+    if let (Some(b), false) = (bundled, looks_like_path(spec)) {
+        let dir = if kind == PresetKind::Fabric { "fabrics/" } else { "" };
+        let file = format!("presets/{dir}{}.toml (bundled)", b.name);
+        return Ok((parse_table(b.text, &file)?, file));
+    }
+    let mut path = PathBuf::from(spec);
+    if let (true, Some(base)) = (path.is_relative(), base) {
+        let candidate = base.join(&path);
+        if candidate.exists() {
+            path = candidate;
+        }
+    }
+    let arcsim = kind == PresetKind::Fabric && is_arcsim_file(spec);
+    if !path.exists() && !looks_like_path(spec) && !arcsim {
+        let available = list.iter().map(|b| b.name).collect::<Vec<_>>().join(", ");
+        return Err(PresetError::Unknown { kind: kind.name(), name: spec.to_string(), available });
+    }
+    let file = path.display().to_string();
+    if arcsim {
+        read_text(&path, FileKind::Arcsim).map_err(|source| PresetError::Read { key, source })?;
+        return Ok((arcsim_fabric_table(&file), file));
+    }
+    let text = read_text(&path, kind.file_kind()).map_err(|source| PresetError::Read { key, source })?;
+    let table = parse_toml(&text, Some(&path), kind.file_kind()).map_err(|message| PresetError::Syntax { file: file.clone(), message })?;
+    if kind == PresetKind::Fabric {
+        refuse_fabric_preset(&table).map_err(|message| PresetError::Invalid { file: file.clone(), message })?;
+    }
+    Ok((table, file))
+}
+
+/// The fabric table an ARCSim material file `file` (`….json`) stands for: named after the
+/// file, its `[arcsim]` section reading it.
+pub fn arcsim_fabric_table(file: &str) -> toml::Table {
+    let stem = Path::new(file).file_stem().map_or_else(|| file.to_string(), |s| s.to_string_lossy().into_owned());
+    let mut table = toml::Table::new();
+    table.insert("name".into(), toml::Value::String(format!("{stem} (ARCSim material)")));
+    table.insert("description".into(), toml::Value::String(format!("ARCSim material {file}, imported by Rosette's projection")));
+    let mut section = toml::Table::new();
+    section.insert("data".into(), toml::Value::String(file.into()));
+    table.insert("arcsim".into(), toml::Value::Table(section));
+    table
+}
+
+/// A fabric file stands alone: `preset` (a fabric to start from) is read only in a scene's
+/// `[fabric]` table, so one in a fabric file would be silently ignored.
+pub fn refuse_fabric_preset(table: &toml::Table) -> Result<(), String> {
+    match table.get("preset") {
+        None => Ok(()),
+        Some(preset) => Err(format!(
+            "preset = {preset}: a fabric file cannot start from another fabric (only a scene's [fabric] table can); \
+             remove the key and give the fabric's values, or name {preset} in the scene's fabric.preset and set the keys that differ under [fabric]"
+        )),
+    }
+}
+
+pub fn parse_table(text: &str, file: &str) -> Result<toml::Table, PresetError> {
+    parse_toml(text, None, FileKind::Scene).map_err(|message| PresetError::Syntax { file: file.to_string(), message })
+}
+
+/// Parses `KEY=VALUE`; VALUE is read as a TOML value (number, array, boolean, quoted
+/// string) and otherwise taken as a bare string.
+pub fn parse_override(text: &str) -> Result<(Vec<String>, toml::Value), PresetError> {
+    let bad = |message: &str| PresetError::BadOverride { text: text.to_string(), message: message.to_string() };
+    let (key, value) = text.split_once('=').ok_or_else(|| bad("expected KEY=VALUE, e.g. solver.dt=0.001"))?;
+    let path: Vec<String> = key.trim().split('.').map(|s| s.trim().to_string()).collect();
+    if path.iter().any(|p| p.is_empty()) {
+        return Err(bad("the key has an empty part; write dotted keys like fabric.areal_density"));
+    }
+    let value = value.trim();
+    let parsed = format!("v = {value}")
+        .parse::<toml::Table>()
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(value.to_string()));
+    Ok((path, parsed))
+}
+
+pub fn apply_override(table: &mut toml::Table, path: &[String], value: toml::Value) -> Result<(), String> {
+    let (last, parents) = path.split_last().expect("non-empty key");
+    let mut current = table;
+    for part in parents {
+        let entry = current.entry(part.clone()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        current = entry.as_table_mut().ok_or_else(|| format!("'{part}' is a value, not a table"))?;
+    }
+    current.insert(last.clone(), value);
+    Ok(())
+}
+
+/// The description line of every bundled scene, for `rosette presets`.
+pub fn scene_descriptions() -> Vec<(&'static str, String)> {
+    SCENES
+        .iter()
+        .map(|b| {
+            let description = parse_table(b.text, b.name)
+                .ok()
+                .and_then(|t| t.get("scene")?.get("description")?.as_str().map(str::to_string))
+                .unwrap_or_default();
+            (b.name, description)
+        })
+        .collect()
+}

@@ -1,0 +1,57 @@
+//! The checks of a garment scene's `[garment]` section and its pattern.
+
+use super::{Invalid, invalid, non_negative, positive, positive_at_most};
+use crate::garment;
+use crate::settings::SceneConfig;
+use glam::DVec2;
+
+/// The stiffest sewing spring a scene may ask for, N/m.
+pub const MAX_SEWING_STIFFNESS: f64 = 1e6;
+
+/// The checks a garment scene passes when it is loaded (`validate::check_scene`): the
+/// `[garment]` section, no `[cloth]` keys, the sewing settings, and the pattern itself
+/// (outlines, grains, seams, attachments, meshing). Returns the smallest panel's smaller
+/// side, m.
+pub fn check(c: &SceneConfig) -> Result<f64, Invalid> {
+    let g = c.garment.as_ref().ok_or_else(|| invalid("garment", "a garment scene needs a [garment] section with its panels and form".into()))?;
+    let cloth = &c.cloth;
+    if cloth.length != 0.0 || cloth.width != 0.0 || cloth.diameter != 0.0 || cloth.warp_angle_deg != 0.0 || cloth.position != [0.0; 3] {
+        return Err(invalid("cloth", "a garment's cloth is its [garment] pattern; remove the [cloth] section (each panel has its own grain_deg and placement)".into()));
+    }
+    let h = positive("mesh.edge_length", c.mesh.edge_length)?;
+    // Springs far stiffer than the cloth they close only make the step's solve
+    // ill-conditioned: at the limit a 1 µm gap already pulls with 1 N.
+    positive_at_most("garment.sewing_stiffness", g.sewing_stiffness, MAX_SEWING_STIFFNESS, "a sewing spring's stiffness in N/m; the default is 50")?;
+    positive("garment.sewing_ramp", g.sewing_ramp)?;
+    positive("garment.sewing_time", g.sewing_time)?;
+    positive("garment.closed_share", g.closed_share)?;
+    non_negative("garment.sewing_damping", g.sewing_damping)?;
+    if g.sewing_time > c.scene.duration {
+        return Err(invalid("garment.sewing_time", format!("garment.sewing_time = {} s is longer than scene.duration = {} s", g.sewing_time, c.scene.duration)));
+    }
+    let measurements = g.form.measurements(g.units).map_err(|e| invalid("garment.form", e.to_string()))?;
+    let level = |name: &str| {
+        let m = measurements.as_ref()?;
+        match name {
+            "waist" => Some(m.waist_height),
+            "hip" => Some(m.hip_height),
+            "bust" => Some(m.bust_height),
+            _ => None,
+        }
+    };
+    let metres = g.units.metres();
+    let garment = garment::build(g, h, DVec2::from_array(g.form.axis) * metres, &level).map_err(|e| invalid("garment", e.to_string()))?;
+    let extent = garment
+        .meshes
+        .iter()
+        .map(|m| {
+            let (lo, hi) = m.points.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+            (hi - lo).min_element()
+        })
+        .fold(f64::INFINITY, f64::min);
+    if h > 0.5 * extent {
+        return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {h} m leaves fewer than 2 elements across the smallest panel ({extent:.3} m); use at most {:.4}", 0.5 * extent)));
+    }
+    Ok(extent)
+}
+
