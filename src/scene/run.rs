@@ -1,7 +1,7 @@
 //! Running a scene to its end: the step loop, divergence handling and the metrics report.
 
 use super::{Measures, Scene};
-use crate::sim::{StepError, StepTimings};
+use crate::sim::{StepError, StepReport, StepTimings};
 use serde::{Deserialize, Deserializer, Serialize};
 use std::time::Instant;
 
@@ -264,13 +264,10 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let wall = Instant::now();
     let cpu = cpu_time::ProcessTime::now();
     let start_time = scene.state.time;
-    let (mut newton, mut quasi_newton, mut cg, mut factorizations) = (0u64, 0u64, 0u64, 0u64);
-    let mut step_time = StepTimings::default();
-    let mut rejected = 0u64;
+    let mut tally = Tally::default();
     let mut error = None;
     let mut settle = SettleWatch::new(scene);
     let mut k = 0u64;
-    let (mut limit_steps, mut worst_residual, mut unconverged) = (0u64, 0.0f64, 0u64);
     let mut stopped_at_limit = None;
     let max_steps = options.max_steps.unwrap_or(scene.config.scene.max_steps);
     // Steps until the end time is reached (a fixed Δt that does not divide the duration
@@ -292,32 +289,10 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
                 break;
             }
         };
-        newton += report.newton_iterations as u64;
-        quasi_newton += report.quasi_newton_iterations as u64;
-        cg += report.cg_iterations as u64;
-        factorizations += report.factorizations as u64;
-        step_time += report.timings;
-        rejected += report.rejected as u64;
-        limit_steps += u64::from(report.newton_unconverged);
-        worst_residual = worst_residual.max(report.newton_residual);
-        unconverged += u64::from(!report.converged());
+        tally.add(&report);
         let rms = settle.rms_speed(scene);
         if let Some(f) = on_step.as_deref_mut() {
-            f(&StepRecord {
-                step: scene.state.steps,
-                time: scene.state.time,
-                dt: report.dt,
-                newton_iterations: report.newton_iterations,
-                quasi_newton_iterations: report.quasi_newton_iterations,
-                cg_iterations: report.cg_iterations,
-                factorizations: report.factorizations,
-                shift: report.shift,
-                newton_unconverged: report.newton_unconverged,
-                newton_residual: report.newton_residual,
-                rms_speed: rms,
-                cpu_seconds: cpu.elapsed().as_secs_f64(),
-                timings: report.timings,
-            });
+            f(&StepRecord::new(scene, &report, rms, cpu.elapsed().as_secs_f64()));
         }
         if let Some(f) = on_state.as_deref_mut() {
             f(scene);
@@ -332,7 +307,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let cpu_seconds = cpu.elapsed().as_secs_f64();
     let simulated = scene.state.time - start_time;
     let per_second = if simulated > 0.0 { cpu_seconds / simulated } else { 0.0 };
-    let metrics = Metrics {
+    let mut metrics = Metrics {
         preset: name.to_string(),
         integrator: scene.integrator.kind.name().to_string(),
         dt,
@@ -344,9 +319,9 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         cpu_seconds_per_simulated_second: per_second,
         cpu_seconds_per_10ms: per_second * 0.01,
         stable: error.is_none(),
-        converged: unconverged == 0,
-        newton_limit_steps: limit_steps,
-        worst_residual,
+        converged: tally.unconverged == 0,
+        newton_limit_steps: tally.limit_steps,
+        worst_residual: tally.worst_residual,
         stopped_at_limit,
         settled: settle.watched().then_some(settle.settled_at.is_some()),
         settle_time: settle.settled_at,
@@ -361,19 +336,69 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             let s = scene.integrator.contact_stats;
             ContactEvents { impacts: s.impacts, resolves: s.resolves }
         }),
-        newton_iterations: newton,
-        quasi_newton_iterations: quasi_newton,
-        cg_iterations: cg,
-        factorizations,
-        rejected_steps: rejected,
+        newton_iterations: tally.newton,
+        quasi_newton_iterations: tally.quasi_newton,
+        cg_iterations: tally.cg,
+        factorizations: tally.factorizations,
+        rejected_steps: tally.rejected,
         peak_memory_bytes: peak_memory_bytes(),
-        step_time,
+        step_time: tally.step_time,
         measures: scene.measures(),
         notes: Vec::new(),
     };
-    let mut metrics = metrics;
     super::possible::judge(scene, &mut metrics, duration);
     (metrics, error)
+}
+
+/// The counts a run sums over its steps.
+#[derive(Default)]
+struct Tally {
+    newton: u64,
+    quasi_newton: u64,
+    cg: u64,
+    factorizations: u64,
+    step_time: StepTimings,
+    rejected: u64,
+    /// Steps whose Newton stopped at its iteration limit.
+    limit_steps: u64,
+    worst_residual: f64,
+    /// Steps that did not converge to their tolerance.
+    unconverged: u64,
+}
+
+impl Tally {
+    fn add(&mut self, report: &StepReport) {
+        self.newton += report.newton_iterations as u64;
+        self.quasi_newton += report.quasi_newton_iterations as u64;
+        self.cg += report.cg_iterations as u64;
+        self.factorizations += report.factorizations as u64;
+        self.step_time += report.timings;
+        self.rejected += report.rejected as u64;
+        self.limit_steps += u64::from(report.newton_unconverged);
+        self.worst_residual = self.worst_residual.max(report.newton_residual);
+        self.unconverged += u64::from(!report.converged());
+    }
+}
+
+impl StepRecord {
+    /// The record of the step `report` just took `scene` through.
+    fn new(scene: &Scene, report: &StepReport, rms_speed: f64, cpu_seconds: f64) -> Self {
+        StepRecord {
+            step: scene.state.steps,
+            time: scene.state.time,
+            dt: report.dt,
+            newton_iterations: report.newton_iterations,
+            quasi_newton_iterations: report.quasi_newton_iterations,
+            cg_iterations: report.cg_iterations,
+            factorizations: report.factorizations,
+            shift: report.shift,
+            newton_unconverged: report.newton_unconverged,
+            newton_residual: report.newton_residual,
+            rms_speed,
+            cpu_seconds,
+            timings: report.timings,
+        }
+    }
 }
 
 /// The process's peak resident set (VmHWM in /proc/self/status), bytes.

@@ -201,20 +201,8 @@ impl Integrator {
             }
             // Backtracking (Armijo) on Φ, short of any cloth–cloth pair meeting; Φ and its
             // gradient are evaluated together at each trial.
-            let mut alpha = limit.min(1.0);
-            let mut accepted = None;
-            for _ in 0..30 {
-                for i in 0..n {
-                    trial[i] = y[i] + alpha * direction[i];
-                }
-                let value = self.evaluate(&problem, &trial, &mut trial_gradient, &mut watch);
-                if value.is_finite() && value <= phi + 1e-4 * alpha * slope {
-                    accepted = Some(value);
-                    break;
-                }
-                alpha *= 0.5;
-            }
-            let Some(mut value) = accepted else {
+            let accepted = self.backtrack(&problem, y, &direction, (phi, slope), limit.min(1.0), (&mut trial, &mut trial_gradient), &mut watch);
+            let Some((mut alpha, mut value)) = accepted else {
                 // Φ cannot be lowered along the direction: round-off level if it is short.
                 // A short direction is still taken: it changes Φ by round-off, and on a free
                 // sheet it leaves no net force (momentum is kept).
@@ -239,15 +227,7 @@ impl Integrator {
             stretch = alpha.max(1.0);
             let step_length = alpha * length;
             steps.push(step_length);
-            let s: Vec<DVec3> = (0..n).map(|i| trial[i] - y[i]).collect();
-            let dg: Vec<DVec3> = (0..n).map(|i| trial_gradient[i] - gradient[i]).collect();
-            let curvature = dot(&s, &dg);
-            if curvature > 1e-12 * dot(&s, &s).sqrt() * dot(&dg, &dg).sqrt() && curvature > 0.0 {
-                if pairs.len() == memory {
-                    pairs.pop_front();
-                }
-                pairs.push_back(Pair { s, dg, rho: 1.0 / curvature });
-            }
+            remember(&mut pairs, memory, y, &trial, &gradient, &trial_gradient);
             std::mem::swap(y, &mut trial);
             std::mem::swap(&mut gradient, &mut trial_gradient);
             phi = value;
@@ -269,6 +249,34 @@ impl Integrator {
         // while a moving one keeps the whole budget.
         self.quasi_budget = if report.newton_unconverged { budget / 2 } else { 2 * budget }.clamp(MIN_BUDGET, self.newton.quasi_newton_iterations.max(MIN_BUDGET));
         !report.newton_unconverged
+    }
+
+    /// Backtracking (Armijo) from `y` along `direction` (Φ and its slope there in `start`),
+    /// from the step `alpha`: the first step that lowers Φ enough, as (step, Φ), with the
+    /// point and its gradient left in `at`; None where 30 halvings do not.
+    #[allow(clippy::too_many_arguments)]
+    fn backtrack(
+        &mut self,
+        problem: &NewtonProblem,
+        y: &[DVec3],
+        direction: &[DVec3],
+        start: (f64, f64),
+        mut alpha: f64,
+        at: (&mut Vec<DVec3>, &mut Vec<DVec3>),
+        watch: &mut Stopwatch,
+    ) -> Option<(f64, f64)> {
+        let ((phi, slope), (trial, trial_gradient)) = (start, at);
+        for _ in 0..30 {
+            for i in 0..y.len() {
+                trial[i] = y[i] + alpha * direction[i];
+            }
+            let value = self.evaluate(problem, trial, trial_gradient, watch);
+            if value.is_finite() && value <= phi + 1e-4 * alpha * slope {
+                return Some((alpha, value));
+            }
+            alpha *= 0.5;
+        }
+        None
     }
 
     /// After a full step accepted at `trial` (Φ = `value`, gradient `trial_gradient`): where
@@ -373,3 +381,19 @@ impl Integrator {
         watch.forces();
     }
 }
+
+/// Keeps the step from `y` to `trial` and its change of gradient as an L-BFGS pair, the
+/// oldest dropped past `memory`, where its curvature is positive (a pair without it would
+/// make the inverse estimate indefinite).
+fn remember(pairs: &mut VecDeque<Pair>, memory: usize, y: &[DVec3], trial: &[DVec3], gradient: &[DVec3], trial_gradient: &[DVec3]) {
+    let s: Vec<DVec3> = y.iter().zip(trial).map(|(a, b)| b - a).collect();
+    let dg: Vec<DVec3> = gradient.iter().zip(trial_gradient).map(|(a, b)| b - a).collect();
+    let curvature = dot(&s, &dg);
+    if curvature > 1e-12 * dot(&s, &s).sqrt() * dot(&dg, &dg).sqrt() && curvature > 0.0 {
+        if pairs.len() == memory {
+            pairs.pop_front();
+        }
+        pairs.push_back(Pair { s, dg, rho: 1.0 / curvature });
+    }
+}
+
