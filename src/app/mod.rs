@@ -7,12 +7,13 @@
 //!   [`plots`]: live test plots and their references; [`files`]: TOML, OBJ, CSV;
 //!   [`chart_view`]: the speed/accuracy charts of `rosette chart`; [`card_view`]: the
 //!   fabric card of the fabric being edited; [`pin`]: a fabric's result kept beside the live
-//!   one.
+//!   one; [`pattern_view`]: a garment's grains and its flat pattern.
 pub mod camera;
 pub mod card_view;
 pub mod chart_view;
 pub mod colour;
 pub mod files;
+pub mod pattern_view;
 pub mod pin;
 pub mod plots;
 pub mod ui;

@@ -6,6 +6,7 @@
 use super::camera::OrbitCamera;
 use super::card_view::CardView;
 use super::chart_view::ChartView;
+use super::pattern_view::PatternView;
 use super::pin::Pinned;
 use super::colour::ColourMap;
 use super::plots::{self, History};
@@ -93,6 +94,8 @@ pub struct ViewerUi {
     pub card: CardView,
     /// A fabric's result kept for comparison, shown at the top of the right panel.
     pub pinned: Option<Pinned>,
+    /// A garment's grains and flat pattern.
+    pub pattern: PatternView,
 }
 
 impl Default for ViewerUi {
@@ -117,6 +120,7 @@ impl Default for ViewerUi {
             chart: ChartView::default(),
             card: CardView::default(),
             pinned: None,
+            pattern: PatternView::default(),
         }
     }
 }
@@ -138,6 +142,7 @@ impl ViewerUi {
         egui::CentralPanel::no_frame().show(ui, |ui| self.view(ui, snapshot, &mut actions));
         self.chart.show(ui.ctx());
         self.card.show(ui.ctx(), self.fabric.as_ref());
+        self.pattern.show(ui.ctx(), snapshot);
         self.flush_fabric(&mut actions);
         actions
     }
@@ -292,6 +297,10 @@ impl ViewerUi {
         });
         if let Some((_, description)) = descriptions.iter().find(|(n, _)| *n == snapshot.scene_name) {
             ui.small(description);
+        }
+        if snapshot.config.garment.is_some() {
+            ui.separator();
+            self.pattern.panel(ui, snapshot, actions);
         }
         ui.separator();
         self.solver_panel(ui, snapshot, actions);

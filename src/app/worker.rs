@@ -50,6 +50,9 @@ pub enum Command {
     /// Switches between the exact and the fast solver path and restarts the scene from
     /// t = 0 (the fast path builds its coarser levels), keeping play/pause.
     SetPath(SolverPath),
+    /// Recuts a garment's panels on these grains (degrees, one per panel, `grain_deg`) and
+    /// restarts the scene from t = 0, keeping play/pause.
+    SetGrains(Vec<f64>),
     /// Holds `vertex` at a point moving towards `target` (m) by at most [`DRAG_SPEED`]·dt
     /// and half an edge per step, so a fast mouse cannot tear the mesh in one step. A second
     /// drag of another vertex releases the first.
@@ -439,6 +442,16 @@ impl WorkerState {
                 config.solver.path = path;
                 let playing = self.playing;
                 self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(format!("solver path not applied: {e}")));
+            }
+            Command::SetGrains(grains) => {
+                let mut config = self.scene.config.clone();
+                if let Some(garment) = config.garment.as_mut() {
+                    for (panel, grain) in garment.panels.iter_mut().zip(grains) {
+                        panel.grain_deg = grain;
+                    }
+                }
+                let playing = self.playing;
+                self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(format!("grains not applied: {e}")));
             }
             Command::DragVertex { vertex, target } => self.drag(vertex, target),
             Command::ReleaseDrag => self.release_drag(),

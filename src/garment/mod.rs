@@ -11,6 +11,7 @@
 //!
 //! This module builds the pattern and the form (`Garment`); `scene::garment` runs them.
 
+pub mod flat;
 pub mod form;
 pub mod mesh;
 pub mod pattern;
@@ -132,10 +133,6 @@ impl Garment {
         pairs
     }
 }
-
-/// Gap between panels laid side by side on the flat pattern (the viewer's and the export's
-/// texture space), m.
-const PATTERN_GAP: f64 = 0.05;
 
 /// Builds the garment's panels at `edge_length` (m) around a form whose axis stands at
 /// `axis` (m), with `levels` giving the height (m) of a named level of the form.
@@ -319,17 +316,17 @@ fn seam_pairs(sides: &[(Side, Side)], cuts: &[Vec<mesh::Cuts>], meshes: &[PanelM
 fn assemble(meshes: &[PanelMesh], grains: &[f64]) -> (PanelSurface, Vec<u32>) {
     let mut surface = PanelSurface::default();
     let mut offsets = Vec::with_capacity(meshes.len());
-    let mut shift = 0.0;
-    for (m, &grain) in meshes.iter().zip(grains) {
+    // Each panel in its warp frame, so that the weave drawn on the texture space (and a
+    // print mapped on an export's) runs along the grain the panel was cut on.
+    let in_warp: Vec<Vec<DVec2>> = meshes.iter().zip(grains).map(|(m, &grain)| m.points.iter().map(|&p| DVec2::from_angle(-grain).rotate(p)).collect()).collect();
+    let shifts = flat::lay_out(in_warp.iter().map(Vec::as_slice));
+    for ((m, points), shift) in meshes.iter().zip(&in_warp).zip(shifts) {
         let offset = surface.pattern.len() as u32;
         offsets.push(offset);
-        let (lo, hi) = m.points.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-        surface.pattern.extend(m.points.iter().map(|p| *p - lo + DVec2::new(shift, 0.0)));
-        shift += hi.x - lo.x + PATTERN_GAP;
-        let to_warp = DVec2::from_angle(-grain);
+        surface.pattern.extend(points.iter().map(|&p| p + shift));
         for t in &m.triangles {
             surface.triangles.push(t.map(|v| v + offset));
-            surface.corners.push(t.map(|v| to_warp.rotate(m.points[v as usize])));
+            surface.corners.push(t.map(|v| points[v as usize]));
         }
     }
     (surface, offsets)
