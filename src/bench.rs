@@ -55,7 +55,8 @@ pub struct BenchRow {
     pub paper_cpu_seconds_per_10ms: Option<f64>,
     /// `exact` or `fast` (`solver.path`).
     pub path: String,
-    /// The drape scenes' coefficient and nodes at the end of the run.
+    /// The drape scenes' coefficient and nodes at the end of the run (a garment's: Cusick's
+    /// against the form's waist, and the hem's nodes).
     pub drape_coefficient: Option<f64>,
     pub nodes: Option<usize>,
     /// The run stopped because the cloth settled.
@@ -189,8 +190,9 @@ fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
         peak_memory_mb: m.peak_memory_bytes.map_or(f64::NAN, |b| b as f64) / 1e6,
         paper_cpu_seconds_per_10ms: case.paper,
         path: if case.overrides.contains(&SolverPath::Fast.setting()) { "fast" } else { "exact" }.to_string(),
-        drape_coefficient: m.measures.drape().map(|d| d.drape_coefficient),
-        nodes: m.measures.drape().map(|d| d.nodes),
+        // A garment's coefficient is Cusick's against the form's waist, its nodes the hem's.
+        drape_coefficient: m.measures.drape().map(|d| d.drape_coefficient).or(m.measures.garment().map(|g| g.garment_drape_coefficient)),
+        nodes: m.measures.drape().map(|d| d.nodes).or(m.measures.garment().map(|g| g.hem_nodes)),
         settled: m.settled,
         max_penetration: m.max_penetration,
         self_intersections: m.self_intersections,
@@ -202,14 +204,20 @@ fn run_case(exe: &Path, case: &Case, threads: usize) -> Result<BenchRow> {
 /// Runs the benchmark and writes `bench.csv` and `bench.json` into `out`.
 pub fn run(out: &Path, quick: bool, threads: &[usize]) -> Result<Vec<BenchRow>> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let rows = measure(quick, threads)?;
+    let rows = measure(quick, threads, None)?;
     write(out, &rows)?;
     Ok(rows)
 }
 
-/// Runs every case with every thread count (each in a child `rosette run`) and prints
-/// the table and its summary.
-pub fn measure(quick: bool, threads: &[usize]) -> Result<Vec<BenchRow>> {
+/// The names of the cases whose name contains `only` (every case without it), in the
+/// order they run.
+pub fn case_names(quick: bool, only: Option<&str>) -> Vec<String> {
+    cases(quick).into_iter().map(|c| c.name).filter(|n| only.is_none_or(|o| n.contains(o))).collect()
+}
+
+/// Runs every case (those whose name contains `only`, where given) with every thread
+/// count (each in a child `rosette run`) and prints the table and its summary.
+pub fn measure(quick: bool, threads: &[usize], only: Option<&str>) -> Result<Vec<BenchRow>> {
     if let Some(t) = threads.iter().find(|&&t| t == 0) {
         bail!("--threads {t}: a run needs at least one thread");
     }
@@ -219,7 +227,7 @@ pub fn measure(quick: bool, threads: &[usize]) -> Result<Vec<BenchRow>> {
         "{:<46} {:>3} {:>7} {:>10} {:>10} {:>6} {:>6} {:>6} {:>7} {:>7} {:>8}",
         "case", "thr", "tris", "CPU s/s", "wall s/s", "forces", "solve", "contact", "newton", "cg/nwt", "peak MB"
     );
-    for case in cases(quick) {
+    for case in cases(quick).into_iter().filter(|c| only.is_none_or(|o| c.name.contains(o))) {
         for &t in threads.iter().filter(|t| case.threads.is_none_or(|only| only.contains(t))) {
             let row = run_case(&exe, &case, t)?;
             outln!(
@@ -336,44 +344,45 @@ fn summarise(rows: &[BenchRow]) {
     }
 }
 
+/// The columns of bench.csv, each its header beside how a row writes it (an absent value
+/// is an empty field).
+const COLUMNS: &[(&str, fn(&BenchRow) -> String)] = &[
+    ("case", |r| format!("\"{}\"", r.case)),
+    ("threads", |r| r.threads.to_string()),
+    ("triangles", |r| r.triangles.to_string()),
+    ("vertices", |r| r.vertices.to_string()),
+    ("steps", |r| r.steps.to_string()),
+    ("simulated_seconds", |r| r.simulated_seconds.to_string()),
+    ("wall_seconds", |r| r.wall_seconds.to_string()),
+    ("cpu_seconds_per_simulated_second", |r| r.cpu_seconds_per_simulated_second.to_string()),
+    ("wall_seconds_per_simulated_second", |r| r.wall_seconds_per_simulated_second.to_string()),
+    ("forces_share", |r| r.forces_share.to_string()),
+    ("solve_share", |r| r.solve_share.to_string()),
+    ("contact_share", |r| r.contact_share.to_string()),
+    ("solver_speedup_bound", |r| optional(r.solver_speedup_bound)),
+    ("newton_per_step", |r| r.newton_per_step.to_string()),
+    ("cg_per_newton", |r| r.cg_per_newton.to_string()),
+    ("peak_memory_mb", |r| r.peak_memory_mb.to_string()),
+    ("paper_cpu_seconds_per_10ms", |r| optional(r.paper_cpu_seconds_per_10ms)),
+    ("path", |r| r.path.clone()),
+    ("drape_coefficient", |r| optional(r.drape_coefficient)),
+    ("nodes", |r| optional(r.nodes)),
+    ("settled", |r| optional(r.settled)),
+    ("max_penetration", |r| optional(r.max_penetration)),
+    ("self_intersections", |r| optional(r.self_intersections)),
+    ("dt", |r| r.dt.to_string()),
+    ("period_error", |r| optional(r.period_error)),
+];
+
+fn optional<T: std::fmt::Display>(value: Option<T>) -> String {
+    value.map_or(String::new(), |v| v.to_string())
+}
+
 fn csv_text(rows: &[BenchRow]) -> String {
     let mut f = String::new();
-    let _ = writeln!(
-        f,
-        "case,threads,triangles,vertices,steps,simulated_seconds,wall_seconds,cpu_seconds_per_simulated_second,\
-         wall_seconds_per_simulated_second,forces_share,solve_share,contact_share,solver_speedup_bound,newton_per_step,cg_per_newton,\
-         peak_memory_mb,paper_cpu_seconds_per_10ms,path,drape_coefficient,nodes,settled,max_penetration,self_intersections,dt,period_error"
-    );
+    let _ = writeln!(f, "{}", COLUMNS.iter().map(|(name, _)| *name).collect::<Vec<_>>().join(","));
     for r in rows {
-        let _ = writeln!(
-            f,
-            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            r.case,
-            r.threads,
-            r.triangles,
-            r.vertices,
-            r.steps,
-            r.simulated_seconds,
-            r.wall_seconds,
-            r.cpu_seconds_per_simulated_second,
-            r.wall_seconds_per_simulated_second,
-            r.forces_share,
-            r.solve_share,
-            r.contact_share,
-            r.solver_speedup_bound.map_or(String::new(), |b| b.to_string()),
-            r.newton_per_step,
-            r.cg_per_newton,
-            r.peak_memory_mb,
-            r.paper_cpu_seconds_per_10ms.map_or(String::new(), |p| p.to_string()),
-            r.path,
-            r.drape_coefficient.map_or(String::new(), |v| v.to_string()),
-            r.nodes.map_or(String::new(), |v| v.to_string()),
-            r.settled.map_or(String::new(), |v| v.to_string()),
-            r.max_penetration.map_or(String::new(), |v| v.to_string()),
-            r.self_intersections.map_or(String::new(), |v| v.to_string()),
-            r.dt,
-            r.period_error.map_or(String::new(), |v| v.to_string())
-        );
+        let _ = writeln!(f, "{}", COLUMNS.iter().map(|(_, value)| value(r)).collect::<Vec<_>>().join(","));
     }
     f
 }

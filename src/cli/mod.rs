@@ -3,7 +3,9 @@
 //! outputs and the exit codes.
 
 pub mod arcsim;
+pub mod args;
 pub mod card;
+pub mod dispatch;
 pub mod fabric;
 pub mod outputs;
 pub mod run;

@@ -3,7 +3,7 @@
 
 use super::outputs::{self, GLTF, METRICS, OUTLINE, PICTURE, STEP_LOG};
 use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, EXIT_NOT_CONVERGED, EXIT_NOT_SEWN, EXIT_STOPPED, bad_input, say_error};
-use crate::ScreenshotArgs;
+use super::args::{DEFAULT_MAX_WALL, ScreenshotArgs};
 use rosette::io::guard::Plan;
 use rosette::io::number::short;
 use rosette::io::write::Output;
@@ -45,7 +45,7 @@ pub struct RunLimits {
 
 impl Default for RunLimits {
     fn default() -> Self {
-        Self { duration: None, max_steps: None, max_wall: crate::DEFAULT_MAX_WALL }
+        Self { duration: None, max_steps: None, max_wall: DEFAULT_MAX_WALL }
     }
 }
 

@@ -39,9 +39,15 @@ pub fn chart(out: PathBuf, quick: bool, force: bool) -> ExitCode {
     }
 }
 
-pub fn bench(out: &Path, quick: bool, threads: &[usize], force: bool) -> ExitCode {
+pub fn bench(out: &Path, quick: bool, threads: &[usize], only: Option<&str>, force: bool) -> ExitCode {
     if let Err(e) = outputs::folder("--out", out) {
         return bad_input(e);
+    }
+    if let Some(only) = only
+        && rosette::bench::case_names(quick, Some(only)).is_empty()
+    {
+        let all = rosette::bench::case_names(quick, None);
+        return bad_input(format!("--only {only}: no bench case's name contains it; the cases{} are: {}", if quick { " with --quick" } else { "" }, all.join("; ")));
     }
     let mut plan = Plan::new(force);
     plan.add("--out", &out.join("bench.csv"), BENCH_CSV);
@@ -49,7 +55,7 @@ pub fn bench(out: &Path, quick: bool, threads: &[usize], force: bool) -> ExitCod
     if let Err(e) = outputs::check(&plan, &[]) {
         return bad_input(e);
     }
-    let rows = match rosette::bench::measure(quick, threads) {
+    let rows = match rosette::bench::measure(quick, threads, only) {
         Ok(rows) => rows,
         Err(e) => {
             say_error(format!("{e:#}"));

@@ -206,7 +206,9 @@ pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
     // vertex arriving at speed v then stops within v·Δt/√c of the same layer as at the
     // scene's own step.
     let resolved = coarsest_edge(config).is_ok_and(|coarsest| edge <= coarsest * (1.0 + 1e-9));
-    let slow = quasi_static(config);
+    // A garment's gravity ramp lowers it onto the form, but its panels are drawn together
+    // by the sewing and then hang: cloth in motion on a body, on its own mesh.
+    let slow = quasi_static(config) && design(config) != Design::Garment;
     let long_dt = if slow { resolved.then_some(fast.dt) } else { Some(fast.drop_dt) };
     if let Some(long_dt) = long_dt.filter(|&d| d > config.solver.dt) {
         level.solver.dt = long_dt;
