@@ -162,6 +162,34 @@ fn a_hanging_panel_stretches_by_its_weight_over_the_modulus_of_its_cut() {
     assert!(runs[1].0 > 4.0 * runs[0].0, "the bias hangs longer: {runs:?}");
 }
 
+/// The weave follows each panel's grain: in the texture space (the weave the viewer and
+/// screenshots draw, an export's texture coordinates) every triangle's edges are its edges
+/// in its own warp frame, on the straight cut and on the bias, and the panels do not overlap
+/// there.
+#[test]
+fn the_texture_space_runs_the_weave_along_each_panels_grain() {
+    for name in ["skirt-gored-straight", "skirt-gored-bias"] {
+        let (config, _) = load_scene(name, &["mesh.edge_length=0.04".into()]).unwrap();
+        let scene = Scene::build(config).unwrap();
+        let (texture, warp) = scene.model.texture_space();
+        assert_eq!(warp, 0.0, "{name}: the texture space is in the warp frame");
+        let frames = scene.model.frames.as_ref().expect("a garment's triangles have frames");
+        for (t, c) in scene.model.triangles.iter().zip(frames) {
+            for k in 1..3 {
+                let drawn = texture[t[k] as usize] - texture[t[0] as usize];
+                assert!((drawn - (c[k] - c[0])).length() < 1e-9, "{name}: triangle {t:?} drawn {drawn} against its warp frame's {}", c[k] - c[0]);
+            }
+        }
+        let area: f64 = scene.model.triangles.iter().map(|t| {
+            let [a, b, c] = t.map(|v| texture[v as usize]);
+            0.5 * (b - a).perp_dot(c - a)
+        }).sum();
+        let (lo, hi) = texture.iter().fold((glam::DVec2::INFINITY, glam::DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        assert!(area > 0.0 && lo.x >= -1e-9 && lo.y >= -1e-9, "{name}: panels laid from the origin, right side up");
+        assert!(hi.x > 4.0 * 0.40 * std::f64::consts::FRAC_1_SQRT_2, "{name}: four gores side by side, not stacked: width {}", hi.x);
+    }
+}
+
 const TUBE: &str = r#"
 [scene]
 kind = "garment"

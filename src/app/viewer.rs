@@ -402,13 +402,13 @@ impl App {
                 return Ok(());
             }
             FileDialog::SaveFabric => write(files::fabric_toml(&snapshot.config.fabric)?)?,
-            FileDialog::ExportObj => write(files::mesh_obj(&snapshot.positions, &snapshot.rest, &snapshot.triangles))?,
+            FileDialog::ExportObj => write(files::mesh_obj(&snapshot.positions, &snapshot.texture, &snapshot.triangles))?,
             FileDialog::ExportCsv => write(files::measures_csv(&snapshot.measures, &self.ui.history.names, &self.ui.history.rows))?,
             FileDialog::ExportGltf => {
                 let cloth = crate::export::Cloth {
                     triangles: &snapshot.triangles,
-                    rest: &snapshot.rest,
-                    warp_angle: snapshot.config.cloth.warp_angle_deg.to_radians(),
+                    rest: &snapshot.texture,
+                    warp_angle: snapshot.warp_angle,
                     name: &snapshot.scene_name,
                 };
                 crate::export::write_glb(path, &cloth, &[(snapshot.time, snapshot.positions.clone())]).map_err(|e| e.to_string())?;
@@ -523,7 +523,7 @@ fn draw_scene(
 /// What the view draws of `snapshot`: the cloth in the chosen colour map, the props and the
 /// floor.
 fn snapshot_frame(snapshot: &Snapshot, ui: &ViewerUi) -> Frame {
-    let mut frame = Frame::from_cloth(&snapshot.positions, &snapshot.triangles, &snapshot.rest, snapshot.config.cloth.warp_angle_deg.to_radians());
+    let mut frame = Frame::from_cloth(&snapshot.positions, &snapshot.triangles, &snapshot.texture, snapshot.warp_angle);
     if let (Some(map), Some(field)) = (render_map(ui.colour_map), colour::field(snapshot, ui.colour_map)) {
         frame.cloth_scalar = Some(ScalarField { map, values: field.values, min: field.min, max: field.max });
     }

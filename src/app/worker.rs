@@ -131,8 +131,11 @@ pub struct Snapshot {
     pub positions: Vec<DVec3>,
     /// Triangles (counter-clockwise in the rest plane), indices into `positions`.
     pub triangles: Arc<Vec<[u32; 3]>>,
-    /// Rest positions in the sample plane, m (for texture coordinates).
-    pub rest: Arc<Vec<glam::DVec2>>,
+    /// Texture coordinates, m: the rest plane, or a garment's texture space (each panel in
+    /// its warp frame); `sim::Model::texture_space`.
+    pub texture: Arc<Vec<glam::DVec2>>,
+    /// The warp's angle from the texture coordinates' x axis, radians.
+    pub warp_angle: f64,
     /// Vertices held by the rig (clamps, grips) or the mouse.
     pub fixed: Vec<bool>,
     /// Surfaces of the scene's props (ground planes excepted): positions (m) and triangles.
@@ -272,7 +275,7 @@ struct WorkerState {
     scene_name: String,
     config: Arc<SceneConfig>,
     triangles: Arc<Vec<[u32; 3]>>,
-    rest: Arc<Vec<glam::DVec2>>,
+    texture: Arc<Vec<glam::DVec2>>,
     props: Arc<Vec<PropSurface>>,
     ground_z: Option<f64>,
     mailbox: Arc<Mailbox>,
@@ -305,7 +308,7 @@ impl WorkerState {
         let mut state = Self {
             config: Arc::new(scene.config.clone()),
             triangles: Arc::new(scene.model.triangles.clone()),
-            rest: Arc::new(scene.model.rest.clone()),
+            texture: Arc::new(scene.model.texture_space().0.to_vec()),
             props: Arc::default(),
             ground_z: None,
             scene,
@@ -483,7 +486,7 @@ impl WorkerState {
     fn install_scene_data(&mut self) {
         self.config = Arc::new(self.scene.config.clone());
         self.triangles = Arc::new(self.scene.model.triangles.clone());
-        self.rest = Arc::new(self.scene.model.rest.clone());
+        self.texture = Arc::new(self.scene.model.texture_space().0.to_vec());
         let (grounds, solids): (Vec<_>, Vec<_>) =
             self.scene.props.iter().partition(|p| matches!(p.shape, crate::sim::contact::PropShape::Ground));
         self.ground_z = grounds.iter().map(|p| p.position.z).reduce(f64::max);
@@ -563,7 +566,7 @@ impl WorkerState {
                     // The fast path moved to a finer level: a new mesh, whose vertices the
                     // mouse no longer holds.
                     self.triangles = Arc::new(self.scene.model.triangles.clone());
-                    self.rest = Arc::new(self.scene.model.rest.clone());
+                    self.texture = Arc::new(self.scene.model.texture_space().0.to_vec());
                     self.drag = None;
                 }
                 let end = Instant::now();
@@ -629,7 +632,8 @@ impl WorkerState {
             config: Arc::clone(&self.config),
             positions: x.clone(),
             triangles: Arc::clone(&self.triangles),
-            rest: Arc::clone(&self.rest),
+            texture: Arc::clone(&self.texture),
+            warp_angle: model.texture_space().1,
             fixed: model.fixed.clone(),
             props: Arc::clone(&self.props),
             ground_z: self.ground_z,

@@ -224,7 +224,8 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
             Some(r) => r.finish(scene.state.time, &scene.state.x),
             None => vec![(scene.state.time, scene.state.x.clone())],
         };
-        let cloth = rosette::export::Cloth { triangles: &scene.model.triangles, rest: &scene.model.rest, warp_angle: scene.model.warp_angle, name: &name };
+        let (rest, warp_angle) = scene.model.texture_space();
+        let cloth = rosette::export::Cloth { triangles: &scene.model.triangles, rest, warp_angle, name: &name };
         match rosette::export::write_glb(path, &cloth, &frames) {
             Ok(()) => errln!("wrote {} ({} frame{})", path.display(), frames.len(), if frames.len() == 1 { "" } else { "s" }),
             Err(e) => fail(format!("--export: {e}")),

@@ -312,18 +312,19 @@ fn seam_pairs(sides: &[(Side, Side)], cuts: &[Vec<mesh::Cuts>], meshes: &[PanelM
 }
 
 /// The panels as one cloth: vertices in panel order, each triangle's corners in its
-/// panel's warp frame, and the flat pattern with the panels side by side.
+/// panel's warp frame, the flat pattern with the panels side by side as cut, and the
+/// texture space with each panel turned into its warp frame (the weave along its grain).
 fn assemble(meshes: &[PanelMesh], grains: &[f64]) -> (PanelSurface, Vec<u32>) {
     let mut surface = PanelSurface::default();
     let mut offsets = Vec::with_capacity(meshes.len());
-    // Each panel in its warp frame, so that the weave drawn on the texture space (and a
-    // print mapped on an export's) runs along the grain the panel was cut on.
     let in_warp: Vec<Vec<DVec2>> = meshes.iter().zip(grains).map(|(m, &grain)| m.points.iter().map(|&p| DVec2::from_angle(-grain).rotate(p)).collect()).collect();
-    let shifts = flat::lay_out(in_warp.iter().map(Vec::as_slice));
-    for ((m, points), shift) in meshes.iter().zip(&in_warp).zip(shifts) {
+    let pattern_shifts = flat::lay_out(meshes.iter().map(|m| m.points.as_slice()));
+    let texture_shifts = flat::lay_out(in_warp.iter().map(Vec::as_slice));
+    for (((m, points), pattern_shift), texture_shift) in meshes.iter().zip(&in_warp).zip(pattern_shifts).zip(texture_shifts) {
         let offset = surface.pattern.len() as u32;
         offsets.push(offset);
-        surface.pattern.extend(points.iter().map(|&p| p + shift));
+        surface.pattern.extend(m.points.iter().map(|&p| p + pattern_shift));
+        surface.texture.extend(points.iter().map(|&p| p + texture_shift));
         for t in &m.triangles {
             surface.triangles.push(t.map(|v| v + offset));
             surface.corners.push(t.map(|v| points[v as usize]));

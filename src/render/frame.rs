@@ -54,7 +54,8 @@ impl Frame {
     pub fn from_scene(scene: &Scene, color_map: Option<ColorMap>) -> Self {
         let model = &scene.model;
         let x = &scene.state.x;
-        let mut frame = Self::from_cloth(x, &model.triangles, &model.rest, model.warp_angle);
+        let (texture, warp_angle) = model.texture_space();
+        let mut frame = Self::from_cloth(x, &model.triangles, texture, warp_angle);
         if let Some(map) = color_map {
             frame.cloth_scalar = Some(scalar_field(scene, map));
         }

@@ -258,17 +258,18 @@ fn weld_surface(surface: &PanelSurface, pairs: &[[u32; 2]]) -> (PanelSurface, Ve
     }
     let mut new_index = vec![u32::MAX; n];
     let mut map = vec![0u32; n];
-    let mut pattern = Vec::new();
+    let (mut pattern, mut texture) = (Vec::new(), Vec::new());
     for v in 0..n as u32 {
         let r = root(&mut parent, v) as usize;
         if new_index[r] == u32::MAX {
             new_index[r] = pattern.len() as u32;
             pattern.push(surface.pattern[r]);
+            texture.push(surface.texture[r]);
         }
         map[v as usize] = new_index[r];
     }
     let triangles = surface.triangles.iter().map(|t| t.map(|v| map[v as usize])).collect();
-    (PanelSurface { triangles, corners: surface.corners.clone(), pattern }, map)
+    (PanelSurface { triangles, corners: surface.corners.clone(), pattern, texture }, map)
 }
 
 impl Scene {

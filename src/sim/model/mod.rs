@@ -79,6 +79,9 @@ pub struct Model {
     /// frame (x along the warp), m. None for a flat specimen, whose frame is `rest` turned
     /// by `warp_angle`.
     pub frames: Option<Vec<[DVec2; 3]>>,
+    /// Where the weave is drawn, per vertex, m, for a cloth of panels: each panel in its
+    /// own warp frame (`PanelSurface::texture`). None: `rest` turned by `warp_angle`.
+    pub texture: Option<Vec<DVec2>>,
     /// Rest length of each of `edges` for a cloth of panels, m (None: from `rest`).
     pub edge_rest_lengths: Option<Vec<f64>>,
     /// Zero-length springs that close seams and hold attachments (empty unless sewn).
@@ -147,6 +150,7 @@ impl Model {
         let geometry = RestGeometry { rest: &surface.pattern, triangles: &surface.triangles, areas: &areas, mean_edge_length: surface.mean_edge_length() };
         let mut model = Self::build(geometry, |t| surface.corners[t], Some(surface.corners.clone()), seam_pairs, fabric, 0.0, options)?;
         model.edge_rest_lengths = Some(surface.edge_rest_lengths(&model.edges));
+        model.texture = Some(surface.texture.clone());
         model.sewing.pairs = seam_pairs.to_vec();
         Ok(model)
     }
@@ -199,6 +203,7 @@ impl Model {
             mass,
             vertex_area,
             warp_angle,
+            texture: None,
             frames,
             edge_rest_lengths: None,
             sewing: Sewing::default(),
@@ -231,6 +236,15 @@ impl Model {
     /// What contact reads of the cloth.
     pub fn cloth(&self) -> Cloth<'_> {
         Cloth { triangles: &self.triangles, edges: &self.edges, fixed: &self.fixed, mass: &self.mass, mean_edge_length: self.mean_edge_length }
+    }
+
+    /// The texture space: per-vertex coordinates and the warp's angle from their x axis
+    /// (radians), the weave drawn along the warp; what screenshots and exports use.
+    pub fn texture_space(&self) -> (&[DVec2], f64) {
+        match &self.texture {
+            Some(texture) => (texture, 0.0),
+            None => (&self.rest, self.warp_angle),
+        }
     }
 
     pub fn vertex_count(&self) -> usize {

@@ -15,10 +15,13 @@ pub struct PanelSurface {
     /// Each triangle's corners in its warp frame (x along the warp, y along the weft), m,
     /// counter-clockwise.
     pub corners: Vec<[DVec2; 3]>,
-    /// Each vertex's place on the flat pattern (panels laid side by side), m: what the
-    /// viewer draws the weave on and what an export takes as texture coordinates. A vertex
-    /// shared by two panels (a welded seam) takes the first panel's.
+    /// Each vertex's place on the flat pattern (panels laid side by side as cut), m. A
+    /// vertex shared by two panels (a welded seam) takes the first panel's.
     pub pattern: Vec<DVec2>,
+    /// Each vertex's place in the texture space (each panel turned into its warp frame,
+    /// the panels laid side by side), m: what the viewer draws the weave on and what an
+    /// export takes as texture coordinates, so that the weave follows each panel's grain.
+    pub texture: Vec<DVec2>,
 }
 
 impl PanelSurface {
@@ -216,7 +219,7 @@ mod tests {
                 p.map(|q| DVec2::from_angle(-grain).rotate(q))
             })
             .collect();
-        let surface = PanelSurface { triangles: mesh.triangles.clone(), corners, pattern: mesh.rest.clone() };
+        let surface = PanelSurface { triangles: mesh.triangles.clone(), corners, pattern: mesh.rest.clone(), texture: mesh.rest.clone() };
         let welded = Model::from_panels(&surface, &[], &fabric(), options).unwrap();
         let x: Vec<DVec3> = mesh.rest.iter().map(|&p| shape(p)).collect();
         let (m0, b0) = whole.elastic_energy(&x);
