@@ -344,9 +344,12 @@ fn summarise(rows: &[BenchRow]) {
     }
 }
 
+/// A column of bench.csv: its header, and how a row writes its field.
+type Column = (&'static str, fn(&BenchRow) -> String);
+
 /// The columns of bench.csv, each its header beside how a row writes it (an absent value
 /// is an empty field).
-const COLUMNS: &[(&str, fn(&BenchRow) -> String)] = &[
+const COLUMNS: &[Column] = &[
     ("case", |r| format!("\"{}\"", r.case)),
     ("threads", |r| r.threads.to_string()),
     ("triangles", |r| r.triangles.to_string()),

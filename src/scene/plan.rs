@@ -227,7 +227,10 @@ pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
             level.solver.newton.preconditioner = if slow { PreconditionerChoice::Cholesky } else { PreconditionerChoice::IncompleteCholesky };
         }
     }
-    level.solver.newton.error_share = fast.error_share;
+    // Garments keep the tighter share: at the motion's, the shift dress settled on 3 hem
+    // nodes instead of the exact path's 5 and the circle skirt did not settle in 6 s
+    // (docs/performance-log.md).
+    level.solver.newton.error_share = if design(config) == Design::Motion { fast.motion_error_share } else { fast.error_share };
     // A cloth landing on a prop buckles in most iterations of its landing steps: once
     // the exact matrix has failed in a step, the rest of the step is solved on the
     // bounded one instead of trying the exact one first again (docs/fast-path.md).

@@ -214,11 +214,10 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
         positive_at_most("solver.fast.drop_dt", fast.drop_dt, duration, &format!("{}: a dropped cloth's step must fit in the run", run.key))?;
     }
     positive("solver.fast.coarsest_edge_share", fast.coarsest_edge_share)?;
-    if !(fast.error_share.is_finite() && (0.0..1.0).contains(&fast.error_share)) {
-        return Err(invalid(
-            "solver.fast.error_share",
-            format!("solver.fast.error_share = {} must lie in [0, 1): a share of the step's local error (0: off; default 0.1)", short(fast.error_share)),
-        ));
+    for (key, share, default) in [("solver.fast.error_share", fast.error_share, 0.1), ("solver.fast.motion_error_share", fast.motion_error_share, 0.3)] {
+        if !(share.is_finite() && (0.0..1.0).contains(&share)) {
+            return Err(invalid(key, format!("{key} = {} must lie in [0, 1): a share of the step's local error (0: off; default {default})", short(share))));
+        }
     }
     if let Some(a) = solver.adaptive.filter(|a| a.enabled) {
         positive("solver.adaptive.tolerance", a.tolerance)?;
