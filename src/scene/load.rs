@@ -325,6 +325,8 @@ mod tests {
         assert!(err.contains("tensile-warp"), "lists what exists: {err}");
         let err = load_scene("tensile-warp", &["solver.dt".into()]).unwrap_err().to_string();
         assert!(err.contains("KEY=VALUE"), "{err}");
+        let err = load_scene("sphere-drop", &["solver.fast.motion_error_share=1".into()]).unwrap_err().to_string();
+        assert!(err.contains("solver.fast.motion_error_share") && err.contains("[0, 1)"), "{err}");
     }
 
     /// The simulator's tests use the wool suiting written out (`sim::model::tests`); it is

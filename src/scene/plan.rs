@@ -297,10 +297,28 @@ mod tests {
         assert!((level.contact.stiffness - config.contact.stiffness * ratio * ratio).abs() < 1e-9 * level.contact.stiffness);
         assert!(level.contact.relative_motion && !level.solver.newton.retry_exact);
         assert_eq!(level.solver.newton.preconditioner, PreconditionerChoice::IncompleteCholesky);
+        assert_eq!(level.solver.newton.error_share, config.solver.fast.motion_error_share);
         // The swing moves freely with no prop: the same design.
         let (_, swing) = plan("swing", &["solver.path=fast"]);
         assert_eq!(swing.design, Design::Motion);
         assert_eq!(swing.levels[0].config.solver.dt, config.solver.fast.drop_dt);
+    }
+
+    /// A garment is lowered onto its form by a gravity ramp, but sewn and hung it moves on a
+    /// body: it keeps its own mesh and takes the step for motion, with the settling levels'
+    /// Newton share (the motion's moved the dress's hem nodes).
+    #[test]
+    fn a_garment_takes_the_step_for_motion_on_its_own_mesh() {
+        let (config, plan) = plan("skirt-circle", &["solver.path=fast"]);
+        assert_eq!(plan.design, Design::Garment);
+        assert_eq!(plan.levels.len(), 1);
+        let level = &plan.levels[0].config;
+        let ratio = config.solver.fast.drop_dt / config.solver.dt;
+        assert_eq!(level.mesh.edge_length, config.mesh.edge_length);
+        assert_eq!(level.solver.dt, config.solver.fast.drop_dt, "not the scene's own step");
+        assert!((level.contact.stiffness - config.contact.stiffness * ratio * ratio).abs() < 1e-9 * level.contact.stiffness);
+        assert_eq!(level.solver.newton.preconditioner, PreconditionerChoice::IncompleteCholesky);
+        assert_eq!(level.solver.newton.error_share, config.solver.fast.error_share);
     }
 
     #[test]
