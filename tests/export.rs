@@ -132,3 +132,32 @@ fn the_cloth_reads_back_with_its_normals_weave_and_animation() {
         }
     }
 }
+
+/// A garment exports its texture space (each panel turned into its warp frame, the panels
+/// side by side: `Model::texture_space`) at the weave's scale, so that a print mapped onto
+/// the bias skirt runs along each gore's grain: the exported coordinates are the model's,
+/// and within each triangle their edges are the triangle's own edges in its warp frame.
+#[test]
+fn a_garment_exports_each_panel_in_its_warp_frame() {
+    let path = temp("skirt-bias.glb");
+    let overrides = ["--set", "mesh.edge_length=0.05", "--duration", "0.02"];
+    let out = Command::new(env!("CARGO_BIN_EXE_rosette")).args(["run", "skirt-gored-bias"]).args(overrides).args(["--export", path.to_str().unwrap()]).output().unwrap();
+    // A run ended before the sewing time is reported unfinished (exit 8), its outputs kept.
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(8), "{stderr}");
+    assert!(stderr.contains("before garment.sewing_time") && stderr.contains("--duration"), "{stderr}");
+    let r = read(&path);
+    let (config, _) = rosette::scene::load_scene("skirt-gored-bias", &["mesh.edge_length=0.05".into()]).unwrap();
+    let scene = rosette::scene::Scene::build(config).unwrap();
+    let period = f64::from(rosette::render::RenderOptions::default().weave_period);
+    let frames = scene.model.frames.as_ref().unwrap();
+    assert_eq!(r.uv.len(), scene.model.vertex_count());
+    for (t, c) in scene.model.triangles.iter().zip(frames) {
+        for k in 1..3 {
+            let (a, b) = (r.uv[t[0] as usize], r.uv[t[k] as usize]);
+            let exported = glam::DVec2::new(f64::from(b[0] - a[0]), f64::from(b[1] - a[1])) * period;
+            assert!((exported - (c[k] - c[0])).length() < 1e-5, "triangle {t:?}: exported edge {exported} against {} in its warp frame", c[k] - c[0]);
+        }
+    }
+}
+

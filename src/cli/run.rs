@@ -264,11 +264,24 @@ fn outcome(name: &str, scene: &Scene, metrics: &rosette::scene::Metrics, error: 
         return ExitCode::from(EXIT_NOT_CONVERGED);
     }
     if let Some(garment) = metrics.measures.garment().filter(|g| !g.sewn) {
-        say_error(format!(
-            "{name}: the garment was not sewn: a seam was still {:.1} mm open at garment.sewing_time, and what was drawn is unfinished; \
-             give the seams more time (garment.sewing_time) or stiffer springs (garment.sewing_stiffness), or place the panels nearer their seams",
-            1e3 * garment.open_seam_gap
-        ));
+        let sewing_time = scene.config.garment.as_ref().map_or(f64::INFINITY, |g| g.sewing_time);
+        let ended = scene.state.time;
+        // A run cut short before the sewing time is unfinished, not a garment that cannot
+        // be sewn: say which.
+        let message = if ended + 1e-9 < sewing_time {
+            format!(
+                "{name}: the garment is not sewn yet: the run ended at {ended:.3} s, before garment.sewing_time = {sewing_time} s, with a seam still {:.1} mm open, \
+                 and what was drawn is unfinished; run at least until the sewing time (--duration)",
+                1e3 * garment.open_seam_gap
+            )
+        } else {
+            format!(
+                "{name}: the garment was not sewn: a seam was still {:.1} mm open at garment.sewing_time, and what was drawn is unfinished; \
+                 give the seams more time (garment.sewing_time) or stiffer springs (garment.sewing_stiffness), or place the panels nearer their seams",
+                1e3 * garment.open_seam_gap
+            )
+        };
+        say_error(message);
         return ExitCode::from(EXIT_NOT_SEWN);
     }
     if output_failed {
