@@ -30,6 +30,19 @@ pub struct Measurements {
     pub shoulder_width: f64,
 }
 
+impl Measurements {
+    /// The height of a named level of the form (`waist`, `hip` or `bust`), m; None for
+    /// another name.
+    pub fn level(&self, name: &str) -> Option<f64> {
+        match name {
+            "waist" => Some(self.waist_height),
+            "hip" => Some(self.hip_height),
+            "bust" => Some(self.bust_height),
+            _ => None,
+        }
+    }
+}
+
 /// The bundled sizes, in metres (sources in docs/garments.md: girths and lengths of the
 /// UK women's sizes 10, 12 and 14 as tabulated by Aldrich, whose bust girths step by 4 cm
 /// as BS EN 13402-3's size designations do; heights derived from the same chart).

@@ -97,15 +97,7 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
     let metres = g.units.metres();
     let (form, measurements) = build_form(config)?;
     let axis = DVec2::new(g.form.axis[0], g.form.axis[1]) * metres;
-    let level = |name: &str| {
-        let m = measurements.as_ref()?;
-        match name {
-            "waist" => Some(m.waist_height),
-            "hip" => Some(m.hip_height),
-            "bust" => Some(m.bust_height),
-            _ => None,
-        }
-    };
+    let level = |name: &str| measurements.as_ref()?.level(name);
     let garment = garment::build(g, config.mesh.edge_length, axis, &level).map_err(|e| SceneError::Setup(e.to_string()))?;
     let thickness = config.contact.thickness;
     check_outside(&garment, &form, thickness)?;

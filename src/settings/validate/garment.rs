@@ -30,15 +30,7 @@ pub fn check(c: &SceneConfig) -> Result<f64, Invalid> {
         return Err(invalid("garment.sewing_time", format!("garment.sewing_time = {} s is longer than scene.duration = {} s", g.sewing_time, c.scene.duration)));
     }
     let measurements = g.form.measurements(g.units).map_err(|e| invalid("garment.form", e.to_string()))?;
-    let level = |name: &str| {
-        let m = measurements.as_ref()?;
-        match name {
-            "waist" => Some(m.waist_height),
-            "hip" => Some(m.hip_height),
-            "bust" => Some(m.bust_height),
-            _ => None,
-        }
-    };
+    let level = |name: &str| measurements.as_ref()?.level(name);
     let metres = g.units.metres();
     let garment = garment::build(g, h, DVec2::from_array(g.form.axis) * metres, &level).map_err(|e| invalid("garment", e.to_string()))?;
     let extent = garment
