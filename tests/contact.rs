@@ -110,6 +110,7 @@ fn friction_follows_coulombs_law_on_an_incline() {
             "contact.self_collision=false",
             "contact.friction_static=0.5",
             "contact.friction_kinetic=0.4",
+            "contact.slip_speed=1e-3",
             "solver.damping=0",
             "solver.dt=0.002",
             "test.perturbation=0.0",
@@ -141,9 +142,11 @@ fn friction_follows_coulombs_law_on_an_incline() {
     let g = rosette::physics::STANDARD_GRAVITY;
     let still = run(20.0);
     let (_, speed) = *still.last().unwrap();
-    // Sticking friction is smoothed below 1 mm/s (contact.slip_speed); sliding would reach
-    // 1.3 m/s by now.
-    assert!(speed.abs() < 2e-3, "at 20° the cloth slides at {speed} m/s");
+    // Sliding would reach 1.3 m/s by now. Friction smoothed below the slip speed v_ε and
+    // measured from each step's start would let it creep on at v_ε·tan θ/μ_s = 0.73 mm/s
+    // (F/(μ_s N) = tan θ/μ_s): measured from where it stuck, static friction holds it.
+    let creep = 1e-3 * 20f64.to_radians().tan() / 0.5;
+    assert!(speed.abs() < 0.05 * creep, "at 20° the cloth slides at {speed} m/s (smoothed friction's creep: {creep} m/s)");
     let sliding = run(35.0);
     let theta = 35f64.to_radians();
     let expected = g * (theta.sin() - 0.4 * theta.cos());

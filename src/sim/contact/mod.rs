@@ -9,9 +9,12 @@
 //!   vertex mass so that it stiffens the Newton system no more than inertia does (c = 100:
 //!   the cloth sinks g·h²/c into its thickness layer under its own weight). Coulomb
 //!   friction enters as IPC's lagged dissipative potential: the normal force λ and the
-//!   plane are frozen over the step, the tangential slip u = T(y − x̂) pays λ·F(|u|) with
+//!   plane are frozen over the step, the tangential slip u = T(y − a) pays λ·F(|u|) with
 //!   F' = μ_s·|u|/ε below the slip threshold ε = v_ε·h (sticking) and decaying from μ_s to
-//!   μ_k beyond it (sliding). Because both are energies, the line search, the energy
+//!   μ_k beyond it (sliding). The slip is measured from a = x̂ where the vertex has just
+//!   arrived or slid, and from the point it stuck at while it sticks: IPC's a = x̂ at every
+//!   step makes sticking viscous, a vertex under a sideways pull F creeping at v_ε·F/(μ_s λ)
+//!   for ever (`StepContacts::hold`). Because both are energies, the line search, the energy
 //!   checks and the unconditional stability of the implicit step are kept. After the
 //!   solve, any path that still enters a prop (a new contact the prediction missed) adds
 //!   its plane and the step is solved again: no vertex tunnels through a thin prop at any
@@ -81,9 +84,9 @@ pub struct ContactSettings {
     pub self_thickness: Option<f64>,
     /// Contact penalty stiffness as a multiple of m/Δt² per vertex (implicit solvers).
     pub stiffness: f64,
-    /// Tangential speed below which friction sticks, m/s. Smoothed (IPC) friction lets a
-    /// sticking cloth under a sideways pull F creep at slip_speed·F/(μN): keep it well
-    /// below the speeds a scene should resolve, and below its settle speed.
+    /// Tangential speed below which friction sticks, m/s: a vertex resting on a prop may
+    /// slip elastically by up to slip_speed·Δt from where it stuck before it slides (its
+    /// friction then a spring of stiffness μ_s·λ/(slip_speed·Δt)).
     pub slip_speed: f64,
     /// Bound how far cloth–cloth pairs can close by their vertices' motion relative to
     /// their common motion, instead of by each vertex's own (additive CCD's centred
@@ -157,6 +160,9 @@ struct PlaneContact {
     stiffness: f64,
     /// Normal force at the start of the step (lagged for friction), N.
     normal_force: f64,
+    /// Where friction measures the slip from: the vertex's start of step, or, while it
+    /// sticks, the point it stuck at (`StepContacts::hold`).
+    stick: DVec3,
 }
 
 /// Two parts of the cloth kept apart over one step: a vertex and a triangle, or two edges.
@@ -279,7 +285,7 @@ impl ContactModel {
             if let Some(sp) = plane {
                 // The lagged normal force: what the penalty pushes with at the step's start.
                 let normal_force = stiffness * (s.thickness - near.distance).max(0.0);
-                planes.push(PlaneContact { vertex: v as u32, prop: p as u32, point: sp.point, normal: sp.normal, stiffness, normal_force });
+                planes.push(PlaneContact { vertex: v as u32, prop: p as u32, point: sp.point, normal: sp.normal, stiffness, normal_force, stick: a });
                 added += 1;
             }
         }

@@ -19,6 +19,42 @@ impl StepContacts {
         self.pairs.len()
     }
 
+    /// Measures friction's slip from the points the vertices stuck at (`stuck`, by vertex,
+    /// from [`Self::stuck_after`] of the step before) instead of from this step's start.
+    ///
+    /// Smoothed friction is viscous below the slip threshold ε: measured from each step's
+    /// start, a sticking vertex under a sideways pull F slides on at slip_speed·F/(μN)
+    /// for ever, and a skirt resting on its form's hips or a tablecloth's middle creeps at
+    /// up to the slip speed, which is the bundled settle speed. Measured from where it
+    /// stuck, the slip grows only until friction balances the pull (εF/(μN) < ε) and the
+    /// vertex then stays: static friction holds, as Coulomb's does.
+    pub fn hold(&mut self, stuck: &[Option<DVec3>]) {
+        for c in &mut self.planes {
+            if let Some(&Some(point)) = stuck.get(c.vertex as usize) {
+                c.stick = point;
+            }
+        }
+    }
+
+    /// After the step to `y`: where each vertex in contact with a prop sticks from for the
+    /// next step (None: not in contact). A vertex within ε of its stick point keeps it; one
+    /// beyond slides, and its stick point is dragged along, ε behind it along the slip, so
+    /// that friction decays from static to kinetic as the smoothed law does.
+    pub fn stuck_after(&self, y: &[DVec3], stuck: &mut Vec<Option<DVec3>>) {
+        stuck.clear();
+        stuck.resize(y.len(), None);
+        for c in &self.planes {
+            if c.normal_force <= 0.0 {
+                continue;
+            }
+            let i = c.vertex as usize;
+            let u = y[i] - c.stick;
+            let t = u - u.dot(c.normal) * c.normal;
+            let slip = t.length();
+            stuck[i] = Some(if slip <= self.slip { c.stick } else { y[i] - self.slip / slip * t });
+        }
+    }
+
     /// Friction dissipation function F(s) and F'(s) of the tangential slip s over the step.
     fn friction(&self, s: f64) -> (f64, f64) {
         let (e, ms, mk) = (self.slip, self.mu_static, self.mu_kinetic);
@@ -45,9 +81,9 @@ impl StepContacts {
         (d, if d > 1e-15 { offset / d } else { DVec3::Z }, weights)
     }
 
-    /// Contact energy plus friction dissipation at positions `y`; `anchor` is x̂ (the
-    /// position the step's velocity is measured from).
-    pub fn energy(&self, y: &[DVec3], anchor: &[DVec3]) -> f64 {
+    /// Contact energy plus friction dissipation at positions `y` (the slip measured from
+    /// each contact's stick point, `PlaneContact::stick`).
+    pub fn energy(&self, y: &[DVec3]) -> f64 {
         let mut e = 0.0;
         for c in &self.planes {
             let i = c.vertex as usize;
@@ -56,7 +92,7 @@ impl StepContacts {
                 e += 0.5 * c.stiffness * gap * gap;
             }
             if c.normal_force > 0.0 {
-                let u = y[i] - anchor[i];
+                let u = y[i] - c.stick;
                 let slip = (u - u.dot(c.normal) * c.normal).length();
                 e += c.normal_force * self.friction(slip).0;
             }
@@ -72,7 +108,7 @@ impl StepContacts {
 
     /// Adds ∇(energy) to `g` and returns the energy: [`Self::energy`] and
     /// [`Self::add_gradient`] from one pass.
-    pub fn energy_and_gradient(&self, y: &[DVec3], anchor: &[DVec3], g: &mut [DVec3], fixed: &[bool]) -> f64 {
+    pub fn energy_and_gradient(&self, y: &[DVec3], g: &mut [DVec3], fixed: &[bool]) -> f64 {
         let mut e = 0.0;
         for c in &self.planes {
             let i = c.vertex as usize;
@@ -82,7 +118,7 @@ impl StepContacts {
                 g[i] -= c.stiffness * gap * c.normal;
             }
             if c.normal_force > 0.0 {
-                let u = y[i] - anchor[i];
+                let u = y[i] - c.stick;
                 let t = u - u.dot(c.normal) * c.normal;
                 let slip = t.length();
                 let (value, slope) = self.friction(slip);
@@ -108,7 +144,7 @@ impl StepContacts {
     }
 
     /// Adds ∇(energy) to `g`.
-    pub fn add_gradient(&self, y: &[DVec3], anchor: &[DVec3], g: &mut [DVec3], fixed: &[bool]) {
+    pub fn add_gradient(&self, y: &[DVec3], g: &mut [DVec3], fixed: &[bool]) {
         for c in &self.planes {
             let i = c.vertex as usize;
             let gap = self.thickness - c.normal.dot(y[i] - c.point);
@@ -116,7 +152,7 @@ impl StepContacts {
                 g[i] -= c.stiffness * gap * c.normal;
             }
             if c.normal_force > 0.0 {
-                let u = y[i] - anchor[i];
+                let u = y[i] - c.stick;
                 let t = u - u.dot(c.normal) * c.normal;
                 let slip = t.length();
                 if slip > 0.0 {
@@ -141,7 +177,7 @@ impl StepContacts {
     /// blocks of `k`; the cloth–cloth pairs' off-diagonal parts come from
     /// [`StepContacts::couplings`]. Both are Gauss–Newton (the normal's rotation is left
     /// out), which keeps the system positive definite.
-    pub fn add_hessian(&self, y: &[DVec3], anchor: &[DVec3], k: &mut BlockCsr) {
+    pub fn add_hessian(&self, y: &[DVec3], k: &mut BlockCsr) {
         for c in &self.planes {
             let i = c.vertex as usize;
             let mut block = DMat3::ZERO;
@@ -154,7 +190,7 @@ impl StepContacts {
                 // F'' < 0 as μ decays to μ_k; 0 is used there. λF'(s)/s along the slip would
                 // be up to μ_s/ε·λ, many times a resting vertex's inertia at a small slip
                 // threshold, and with it Newton creeps along a sliding vertex's path.
-                let u = y[i] - anchor[i];
+                let u = y[i] - c.stick;
                 let t = u - u.dot(c.normal) * c.normal;
                 let slip = t.length();
                 let tangent = DMat3::IDENTITY - outer(c.normal, c.normal);
@@ -186,7 +222,7 @@ impl StepContacts {
     /// their stiffest direction (the penalty's k where the vertex is inside a prop's layer,
     /// friction's curvature across the slip λF'(s)/s, the cloth–cloth pairs' k w²), as an
     /// isotropic term: the quasi-Newton step's matrix takes contact in that form.
-    pub fn add_isotropic_stiffness(&self, y: &[DVec3], anchor: &[DVec3], diagonal: &mut [f64]) {
+    pub fn add_isotropic_stiffness(&self, y: &[DVec3], diagonal: &mut [f64]) {
         for c in &self.planes {
             let i = c.vertex as usize;
             let mut k: f64 = 0.0;
@@ -194,7 +230,7 @@ impl StepContacts {
                 k = c.stiffness;
             }
             if c.normal_force > 0.0 {
-                let u = y[i] - anchor[i];
+                let u = y[i] - c.stick;
                 let slip = (u - u.dot(c.normal) * c.normal).length().max(self.slip);
                 k = k.max(c.normal_force * self.friction(slip).1 / slip);
             }

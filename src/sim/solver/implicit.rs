@@ -53,6 +53,7 @@ impl Integrator {
                 // falling cloth is about to make are there from the first iteration.
                 let predicted: Vec<DVec3> = (0..n).map(|i| inertial[i] + h * h * model.options.gravity).collect();
                 let mut contacts = contact.begin_step(model.cloth(), &mut self.near_pairs, &s.x, &predicted, h);
+                contacts.hold(&s.stuck);
                 // Newton's path must start where the cloth is: jumping straight to the
                 // inertial guess could carry a vertex through a layer before any contact
                 // force acts. Start from x_n moved towards the guess as far as no cloth–cloth
@@ -72,6 +73,7 @@ impl Integrator {
                     self.minimize(&step, Some(&contacts), &mut y, &mut report);
                     watch.restart();
                     let missed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &y, h);
+                    contacts.hold(&s.stuck);
                     watch.contact();
                     if missed == 0 {
                         break;
@@ -82,6 +84,7 @@ impl Integrator {
                     }
                 }
                 report.timings += watch.timings;
+                contacts.stuck_after(&y, &mut s.stuck);
                 step_contacts = Some(contacts);
             }
         }

@@ -48,12 +48,15 @@ pub struct State {
     pub steps: u64,
     /// Previous positions and velocities (for BDF2), cleared when the history is invalid.
     pub(super) previous: Option<(Vec<DVec3>, Vec<DVec3>)>,
+    /// Where each vertex resting on a prop sticks from, by vertex (`StepContacts::hold`):
+    /// part of the state, so that a rejected step leaves it as it was.
+    pub(super) stuck: Vec<Option<DVec3>>,
 }
 
 impl State {
     pub fn at_rest(x: Vec<DVec3>) -> Self {
         let v = vec![DVec3::ZERO; x.len()];
-        Self { x, v, time: 0.0, steps: 0, previous: None }
+        Self { x, v, time: 0.0, steps: 0, previous: None, stuck: Vec::new() }
     }
 
     /// Forgets the previous step (BDF2's history), as a change of time step requires.

@@ -83,7 +83,7 @@ impl<'a> NewtonProblem<'a> {
 
     /// Φ at `y`, contact included.
     pub fn objective(&self, y: &[DVec3]) -> f64 {
-        self.step.potential(y) + self.contacts.map_or(0.0, |c| c.energy(y, self.step.anchor))
+        self.step.potential(y) + self.contacts.map_or(0.0, |c| c.energy(y))
     }
 
     /// Assembles the in-plane stiffness at `y` with `compressed` edges, and contact's
@@ -91,7 +91,7 @@ impl<'a> NewtonProblem<'a> {
     pub fn assemble(&self, y: &[DVec3], k: &mut BlockCsr, compressed: CompressedEdges) {
         self.step.model.assemble_membrane_stiffness_within(y, k, compressed);
         if let Some(c) = self.contacts {
-            c.add_hessian(y, self.step.anchor, k);
+            c.add_hessian(y, k);
         }
     }
 }
@@ -204,7 +204,7 @@ impl Integrator {
         }
         watch.forces();
         if let Some(c) = problem.contacts {
-            c.add_gradient(y, anchor, gradient, &model.fixed);
+            c.add_gradient(y, gradient, &model.fixed);
             for (g, &f) in gradient.iter_mut().zip(&model.fixed) {
                 if f {
                     *g = DVec3::ZERO;

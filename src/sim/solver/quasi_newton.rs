@@ -130,7 +130,7 @@ impl Integrator {
         let quasi = self.quasi.as_mut().expect("made above");
         let mut diagonal = problem.mass_diagonal.clone();
         if let Some(c) = problem.contacts {
-            c.add_isotropic_stiffness(y, problem.step.anchor, &mut diagonal);
+            c.add_isotropic_stiffness(y, &mut diagonal);
         }
         quasi.factor = ScalarFactor::new(&quasi.pattern, &diagonal, &quasi.constant);
         report.factorizations += 1;
@@ -343,7 +343,7 @@ impl Integrator {
         }
         watch.forces();
         if let Some(c) = problem.contacts {
-            phi += c.energy_and_gradient(y, anchor, gradient, &model.fixed);
+            phi += c.energy_and_gradient(y, gradient, &model.fixed);
             for (g, &f) in gradient.iter_mut().zip(&model.fixed) {
                 if f {
                     *g = DVec3::ZERO;
