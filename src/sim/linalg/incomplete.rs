@@ -46,8 +46,18 @@ pub enum FactorPattern {
     Ring,
 }
 
-/// Vertices per part of a split factor: below twice this a factor is one part.
+/// Vertices per part of a split factor, roughly: below this a factor is one part.
 pub(super) const PART_VERTICES: usize = 4096;
+
+/// How many parts a factor over `n` vertices is split into: one below [`PART_VERTICES`],
+/// else one per `PART_VERTICES` but at least two. The two-part floor is for the meshes of
+/// 4 096–8 191 vertices (a 10k-triangle garment): as one part their triangular solves,
+/// half of a step's time, ran on one thread while the other waited. Split in two, a
+/// 10 226-triangle circle skirt took 3 % more conjugate-gradient iterations at 21 % less
+/// time each on two threads (docs/performance-log.md).
+pub(super) fn part_count(n: usize) -> usize {
+    if n < PART_VERTICES { 1 } else { (n / PART_VERTICES).max(2) }
+}
 
 /// The factor of the diagonal block of rows `start..start + pivot_inverse.len()`.
 struct FactorPart {
@@ -76,7 +86,7 @@ impl IncompleteCholesky {
     pub(super) fn new(a: &SystemMatrix, shift: f64, pattern: FactorPattern) -> Option<Self> {
         use rayon::prelude::*;
         let n = a.fixed.len();
-        let count = if n < 2 * PART_VERTICES { 1 } else { n / PART_VERTICES };
+        let count = part_count(n);
         let bounds: Vec<(usize, usize)> = (0..count).map(|p| (p * n / count, (p + 1) * n / count)).collect();
         // The contact couplings' off-diagonal blocks k·c_i c_j·nnᵀ, by row (columns below the
         // row, ascending, summed). Without them the factor sees each coupled vertex held
