@@ -12,7 +12,7 @@
 //!   fast path ─┬ settles, no props or a ramp ─ Settling: coarse to fine, long steps
 //!              ├ in motion (props, no ramp,
 //!              │  or the swing) ────────────── Motion: own mesh, the step for motion
-//!              ├ a garment ─────────────────── Garment: own mesh, the step for motion
+//!              ├ a garment ─────────────────── Garment: own mesh, the garment's step
 //!              └ a laboratory rig ──────────── Exact (the loading is the experiment)
 //! ```
 
@@ -36,7 +36,7 @@ pub enum Design {
     /// scene's own mesh at the step for cloth in motion (docs/fast-path.md, item 6).
     Motion,
     /// A garment on the fast path: its own mesh (its panels are sewn and welded once) at
-    /// the step for cloth in motion.
+    /// the garment's step (`solver.fast.garment_dt`), contact as for cloth in motion.
     Garment,
 }
 
@@ -46,7 +46,7 @@ impl Design {
             Self::Exact => "the scene's own mesh and settings throughout",
             Self::Settling => "coarse to fine: each level settles, then the next finer one",
             Self::Motion => "cloth in motion: the scene's own mesh at the fast path's step for motion",
-            Self::Garment => "a garment: its own mesh at the fast path's step for motion",
+            Self::Garment => "a garment: its own mesh at the fast path's step for garments",
         }
     }
 }
@@ -135,10 +135,11 @@ impl RunPlan {
                 let factor = c.contact.stiffness / scene.contact.stiffness;
                 let _ = writeln!(
                     text,
-                    "  contact: stiffness {} m/dt²{}, pair list kept by {} motion",
+                    "  contact: stiffness {} m/dt²{}, pair list kept by {} motion, friction sticks below {:.2} mm/s",
                     c.contact.stiffness,
                     if factor != 1.0 { format!(" (the scene's × {factor:.3})") } else { String::new() },
                     if c.contact.relative_motion { "relative" } else { "absolute" },
+                    1e3 * c.contact.slip_speed,
                 );
             }
         }
@@ -207,9 +208,14 @@ pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
     // scene's own step.
     let resolved = coarsest_edge(config).is_ok_and(|coarsest| edge <= coarsest * (1.0 + 1e-9));
     // A garment's gravity ramp lowers it onto the form, but its panels are drawn together
-    // by the sewing and then hang: cloth in motion on a body, on its own mesh.
+    // by the sewing and then hang: cloth in motion on a body, on its own mesh, at its own
+    // step (`garment_dt`, with the penalty rescaled as a drop's).
     let slow = quasi_static(config) && design(config) != Design::Garment;
-    let long_dt = if slow { resolved.then_some(fast.dt) } else { Some(fast.drop_dt) };
+    let long_dt = match (slow, design(config)) {
+        (true, _) => resolved.then_some(fast.dt),
+        (false, Design::Garment) => Some(fast.garment_dt),
+        (false, _) => Some(fast.drop_dt),
+    };
     if let Some(long_dt) = long_dt.filter(|&d| d > config.solver.dt) {
         level.solver.dt = long_dt;
         if !slow {
@@ -305,17 +311,18 @@ mod tests {
     }
 
     /// A garment is lowered onto its form by a gravity ramp, but sewn and hung it moves on a
-    /// body: it keeps its own mesh and takes the step for motion, with the settling levels'
-    /// Newton share (the motion's moved the dress's hem nodes).
+    /// body: it keeps its own mesh and takes the garment's step, with the contact penalty
+    /// rescaled as a drop's is, and the settling levels' Newton share (the motion's moved the
+    /// dress's hem nodes).
     #[test]
-    fn a_garment_takes_the_step_for_motion_on_its_own_mesh() {
+    fn a_garment_takes_the_garment_step_on_its_own_mesh() {
         let (config, plan) = plan("skirt-circle", &["solver.path=fast"]);
         assert_eq!(plan.design, Design::Garment);
         assert_eq!(plan.levels.len(), 1);
         let level = &plan.levels[0].config;
-        let ratio = config.solver.fast.drop_dt / config.solver.dt;
+        let ratio = config.solver.fast.garment_dt / config.solver.dt;
         assert_eq!(level.mesh.edge_length, config.mesh.edge_length);
-        assert_eq!(level.solver.dt, config.solver.fast.drop_dt, "not the scene's own step");
+        assert_eq!(level.solver.dt, config.solver.fast.garment_dt, "not the scene's own step");
         assert!((level.contact.stiffness - config.contact.stiffness * ratio * ratio).abs() < 1e-9 * level.contact.stiffness);
         assert_eq!(level.solver.newton.preconditioner, PreconditionerChoice::IncompleteCholesky);
         assert_eq!(level.solver.newton.error_share, config.solver.fast.error_share);

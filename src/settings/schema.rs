@@ -324,6 +324,13 @@ pub struct FastSettings {
     /// came out 0.23–0.26 at 32 ms against the exact path's 0.066–0.146 over eight seeds,
     /// and 0.129–0.141 at 16 ms over seeds 1–3).
     pub drop_dt: f64,
+    /// Time step of a garment, s: its panels are lowered by the gravity ramp and drawn
+    /// together by the sewing, and it then hangs on its form, held by friction and its own
+    /// seams. The drop's 16 ms: at 32 ms the 10k-triangle circle skirt settled in 52 s
+    /// against 70 s and three of the four bundled garments came as close to the exact
+    /// path as at 16 ms, but the shift dress had not settled when its 6 s ran out
+    /// (docs/performance-log.md). A speed a user may choose, not a default.
+    pub garment_dt: f64,
     /// Largest edge of the coarsest level as a share of the fabric's bending length
     /// (B/w)^(1/3): coarse enough to be cheap, fine enough that folds, whose width scales
     /// with the bending length, span several elements.
@@ -340,7 +347,7 @@ pub struct FastSettings {
 
 impl Default for FastSettings {
     fn default() -> Self {
-        Self { dt: 0.064, drop_dt: 0.016, coarsest_edge_share: 0.5, error_share: 0.1, motion_error_share: 0.3 }
+        Self { dt: 0.064, drop_dt: 0.016, garment_dt: 0.016, coarsest_edge_share: 0.5, error_share: 0.1, motion_error_share: 0.3 }
     }
 }
 

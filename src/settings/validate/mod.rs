@@ -209,9 +209,11 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
     let fast = &solver.fast;
     positive("solver.fast.dt", fast.dt)?;
     positive("solver.fast.drop_dt", fast.drop_dt)?;
+    positive("solver.fast.garment_dt", fast.garment_dt)?;
     if solver.path == SolverPath::Fast {
         positive_at_most("solver.fast.dt", fast.dt, duration, &format!("{}: the fast path's long step must fit in the run", run.key))?;
         positive_at_most("solver.fast.drop_dt", fast.drop_dt, duration, &format!("{}: a dropped cloth's step must fit in the run", run.key))?;
+        positive_at_most("solver.fast.garment_dt", fast.garment_dt, duration, &format!("{}: a garment's step must fit in the run", run.key))?;
     }
     positive("solver.fast.coarsest_edge_share", fast.coarsest_edge_share)?;
     for (key, share, default) in [("solver.fast.error_share", fast.error_share, 0.1), ("solver.fast.motion_error_share", fast.motion_error_share, 0.3)] {
