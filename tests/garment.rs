@@ -285,33 +285,38 @@ fn gore_load_integral(waist: f64, hem: f64, length: f64, from: f64) -> f64 {
 }
 
 /// The gored skirt cut on the bias stretches down its gores more than the straight cut by
-/// what the bias's E₄₅ (eq. 1) predicts: each gore's centre line carries the weight of the
-/// cloth below it, ρg ∫ w / w per unit width, so it lengthens by ρg I (1/E_θ) with I the
-/// integral above. The form's hips carry part of the skirt above the hip line, so the
-/// measured difference lies between the prediction from the hip down (the part that hangs
-/// free) and from the waist down; each bound is given 15 % for the coarse mesh's folds,
-/// whose paths along the centre line lengthen it a little in both cuts alike.
+/// what the bias's E₄₅ (eq. 1) predicts, where the gores hang free: below the hip line the
+/// skirt touches nothing, and each gore's centre line carries the weight of the cloth below
+/// it, ρg ∫ w / w per unit width, so it lengthens by ρg I / E_θ with I the integral above
+/// (`gore_load_integral`) from the hip line down. Above it the skirt rests on the hips,
+/// whose contact carries its weight and stretches it around: no hanging-sheet formula
+/// holds there, and the hem's height (the bias about 4.5 mm lower) is set mostly by how far
+/// each cut flares out from the hips, not by stretch (docs/garments.md).
 ///
-/// Fails today, and is left out of the default run until it is understood: on the 4 cm
-/// mesh the bias gores' centre lines come out 0.14 mm longer than the straight ones, against
-/// 0.57 to 1.64 mm predicted, and both are a little shorter than their rest length (the
-/// skirt sits on the form's hips, which carry its weight by contact and friction rather
-/// than as tension down the gores). The hems differ by 4.9 mm (bias lower), more than the
-/// prediction, with different folds (6 nodes against 8). docs/garments.md, open questions.
+/// Measured on the preset's 2 cm mesh: the bias gores' free part 0.657 mm longer than at
+/// rest (ρgI/E₄₅: 0.672 mm), the straight ones 0.143 mm (ρgI/E₀: 0.099 mm), a difference of
+/// 0.514 mm against 0.573 mm; 0.514 mm again on 1.41 cm edges; on 4 cm edges (four to ten
+/// elements across a gore) 0.890 mm. The straight cut's own stretch, a seventh of the
+/// bias's, is not held to its prediction (it comes out 0.04–0.09 mm longer: the hips' pull
+/// reaches below the hip line, and at a tenth of a millimetre the folds' paths count); the
+/// bias's free part is held to 15 % of its prediction and the difference between the cuts
+/// to 20 %.
 #[test]
-#[ignore = "measured 0.14 mm against 0.57-1.64 mm predicted: the skirt rests on the hips (docs/garments.md, open questions)"]
 fn the_bias_cut_gores_stretch_by_what_e45_predicts() {
+    let (length, hip) = (0.5613, 0.206);
+    // Each gore's free part on the flat pattern: gores 40 cm wide laid 5 cm apart, the
+    // hem's lowest point at y = 0 and the waist's at 56.13 cm.
+    let free = length - hip;
     let runs: Vec<(f64, f64)> = std::thread::scope(|s| {
         let handles: Vec<_> = ["skirt-gored-straight", "skirt-gored-bias"]
             .into_iter()
             .map(|name| {
                 s.spawn(move || {
-                    let (config, _) = load_scene(name, &["mesh.edge_length=0.04".into()]).unwrap();
+                    let (config, _) = load_scene(name, &[]).unwrap();
                     let mut scene = Scene::build(config).unwrap();
                     let (metrics, error) = run_scene(&mut scene, name, RunOptions::default());
-                    assert!(error.is_none() && metrics.measures.garment().unwrap().sewn, "{name}: {error:?}");
-                    // Each gore's centre line on the flat pattern: gores 40 cm wide laid 5 cm
-                    // apart, the hem's lowest point at y = 0 and the waist's at 56.13 cm.
+                    let garment = metrics.measures.garment().unwrap();
+                    assert!(error.is_none() && garment.sewn && metrics.settled == Some(true), "{name}: {error:?}");
                     // Triangles at a welded seam have one corner drawn on the other panel's
                     // place on the flat pattern: only those whose drawn shape is their rest
                     // shape are searched (the centre lines lie far from the seams).
@@ -323,17 +328,18 @@ fn the_bias_cut_gores_stretch_by_what_e45_predicts() {
                     });
                     let triangles = scene.model.triangles.iter().zip(corners).filter(|(t, c)| drawn(t, c)).map(|(t, _)| *t).collect();
                     let flat = rosette::sim::Mesh { rest: rest.clone(), triangles };
-                    let rest_length = 0.541131 + 0.020157;
+                    // Sampled finely enough that every triangle the line crosses holds a
+                    // sample: the path is then the material line's own length.
                     let stretch: f64 = (0..4)
                         .map(|k| {
                             let x = k as f64 * 0.45 + 0.20;
-                            let points: Vec<glam::DVec2> = (0..=40).map(|i| glam::DVec2::new(x, rest_length * i as f64 / 40.0)).collect();
+                            let points: Vec<glam::DVec2> = (0..=400).map(|i| glam::DVec2::new(x, free * i as f64 / 400.0)).collect();
                             let along: Vec<glam::DVec3> = flat.embed(&points).iter().map(|e| e.position(&scene.state.x)).collect();
-                            along.windows(2).map(|w| w[0].distance(w[1])).sum::<f64>() - rest_length
+                            along.windows(2).map(|w| w[0].distance(w[1])).sum::<f64>() - free
                         })
                         .sum::<f64>()
                         / 4.0;
-                    (stretch, metrics.measures.garment().unwrap().hem_height_mean)
+                    (stretch, garment.hem_height_mean)
                 })
             })
             .collect();
@@ -341,16 +347,16 @@ fn the_bias_cut_gores_stretch_by_what_e45_predicts() {
     });
     let (config, _) = load_scene("skirt-gored-bias", &[]).unwrap();
     let f = &config.fabric.properties;
-    let (e0, e45) = (
-        modulus_at(0.0, initial_slope(&f.tensile_warp), initial_slope(&f.tensile_weft), f.shear_modulus, f.poisson_warp),
-        modulus_at(45f64.to_radians(), initial_slope(&f.tensile_warp), initial_slope(&f.tensile_weft), f.shear_modulus, f.poisson_warp),
+    let modulus = |deg: f64| modulus_at(deg.to_radians(), initial_slope(&f.tensile_warp), initial_slope(&f.tensile_weft), f.shear_modulus, f.poisson_warp);
+    let (e0, e45) = (modulus(0.0), modulus(45.0));
+    let load = f.areal_density * rosette::physics::STANDARD_GRAVITY * gore_load_integral(0.176, 0.40, length, hip);
+    let (straight, bias) = (load / e0, load / e45);
+    let difference = bias - straight;
+    eprintln!(
+        "free parts stretched {:.3} mm (straight, eq. 1: {:.3}) and {:.3} mm (bias, eq. 1: {:.3}); hems at {:.4} m and {:.4} m",
+        1e3 * runs[0].0, 1e3 * straight, 1e3 * runs[1].0, 1e3 * bias, runs[0].1, runs[1].1
     );
-    let (length, hip) = (0.5613, 0.206);
-    let weight = f.areal_density * rosette::physics::STANDARD_GRAVITY;
-    let compliance = 1.0 / e45 - 1.0 / e0;
-    let (low, high) = (weight * gore_load_integral(0.176, 0.40, length, hip) * compliance, weight * gore_load_integral(0.176, 0.40, length, 0.0) * compliance);
+    assert!((runs[1].0 / bias - 1.0).abs() < 0.15, "the bias gores stretched {:.3} mm, eq. 1 predicts {:.3} mm", 1e3 * runs[1].0, 1e3 * bias);
     let measured = runs[1].0 - runs[0].0;
-    eprintln!("centre lines stretched {:.2} mm (straight), {:.2} mm (bias); hems at {:.4} m and {:.4} m; eq. 1 predicts {:.2} to {:.2} mm more on the bias",
-        1e3 * runs[0].0, 1e3 * runs[1].0, runs[0].1, runs[1].1, 1e3 * low, 1e3 * high);
-    assert!(measured > 0.85 * low && measured < 1.15 * high, "bias stretched {:.3} mm more, eq. 1 predicts {:.3} to {:.3} mm", 1e3 * measured, 1e3 * low, 1e3 * high);
+    assert!((measured / difference - 1.0).abs() < 0.2, "bias stretched {:.3} mm more, eq. 1 predicts {:.3} mm", 1e3 * measured, 1e3 * difference);
 }
