@@ -210,8 +210,9 @@ pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
     // A garment's gravity ramp lowers it onto the form, but its panels are drawn together
     // by the sewing and then hang: cloth in motion on a body, on its own mesh, at its own
     // step (`garment_dt`, with the penalty rescaled as a drop's).
-    let slow = quasi_static(config) && design(config) != Design::Garment;
-    let long_dt = match (slow, design(config)) {
+    let kind = design(config);
+    let slow = quasi_static(config) && kind != Design::Garment;
+    let long_dt = match (slow, kind) {
         (true, _) => resolved.then_some(fast.dt),
         (false, Design::Garment) => Some(fast.garment_dt),
         (false, _) => Some(fast.drop_dt),
@@ -236,7 +237,7 @@ pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
     // Garments keep the tighter share: at the motion's, the shift dress settled on 3 hem
     // nodes instead of the exact path's 5 and the circle skirt did not settle in 6 s
     // (docs/performance-log.md).
-    level.solver.newton.error_share = if design(config) == Design::Motion { fast.motion_error_share } else { fast.error_share };
+    level.solver.newton.error_share = if kind == Design::Motion { fast.motion_error_share } else { fast.error_share };
     // A cloth landing on a prop buckles in most iterations of its landing steps: once
     // the exact matrix has failed in a step, the rest of the step is solved on the
     // bounded one instead of trying the exact one first again (docs/fast-path.md).

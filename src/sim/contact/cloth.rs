@@ -505,7 +505,7 @@ mod tests {
         let mut near = NearPairs::default();
         let candidates = contact.candidates(model.cloth(), &mut near, &start, &predicted, 0.002, skin(model.cloth())).into_owned();
         let found = candidates.vertex_triangle.len() + candidates.edge_edge.len();
-        let contacts = contact.begin_step(model.cloth(), &mut near, &start, &predicted, 0.004);
+        let contacts = contact.begin_step(model.cloth(), &mut near, &start, &[], &predicted, 0.004);
         let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
         assert_eq!(listed, all_pairs(&model, &start, &predicted, 0.002, true));
         assert!(!listed.is_empty() && found <= 3 * listed.len(), "{found} candidates for {} pairs", listed.len());
@@ -523,7 +523,7 @@ mod tests {
         for (motion, expected) in [(DVec3::new(0.0, 0.005, 0.0), 1.0), (DVec3::new(0.0, 0.0, -0.005), 0.9 * 0.2)] {
             let d: Vec<DVec3> = model.rest.iter().map(|&p| if upper(p) { motion } else { DVec3::ZERO }).collect();
             let predicted: Vec<DVec3> = start.iter().zip(&d).map(|(x, d)| *x + *d).collect();
-            let contacts = contact.begin_step(model.cloth(), &mut NearPairs::default(), &start, &predicted, 0.004);
+            let contacts = contact.begin_step(model.cloth(), &mut NearPairs::default(), &start, &[], &predicted, 0.004);
             assert!(contacts.pair_count() > 100, "the layers are in contact: {} pairs", contacts.pair_count());
             let limit = contacts.max_step(&start, &d);
             assert!((limit - expected).abs() < 1e-6, "moving by {motion}: step limited to {limit}, expected {expected}");
@@ -570,7 +570,7 @@ mod tests {
             let t = step as f64;
             let start: Vec<DVec3> = model.rest.iter().map(|&p| at(p, t)).collect();
             let predicted: Vec<DVec3> = model.rest.iter().map(|&p| at(p, t + 1.0)).collect();
-            let contacts = contact.begin_step(model.cloth(), &mut near, &start, &predicted, 0.004);
+            let contacts = contact.begin_step(model.cloth(), &mut near, &start, &[], &predicted, 0.004);
             let listed: BTreeSet<_> = contacts.pairs.iter().map(|p| (p.vertices, p.edge_edge)).collect();
             assert_eq!(listed.len(), contacts.pairs.len(), "step {step}: a pair listed twice");
             assert_eq!(listed, all_pairs(model, &start, &predicted, 0.002, relative), "step {step}");

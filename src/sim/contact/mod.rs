@@ -14,7 +14,7 @@
 //!   μ_k beyond it (sliding). The slip is measured from a = x̂ where the vertex has just
 //!   arrived or slid, and from the point it stuck at while it sticks: IPC's a = x̂ at every
 //!   step makes sticking viscous, a vertex under a sideways pull F creeping at v_ε·F/(μ_s λ)
-//!   for ever (`StepContacts::hold`). Because both are energies, the line search, the energy
+//!   for ever (`StepContacts::stuck_after`). Because both are energies, the line search, the energy
 //!   checks and the unconditional stability of the implicit step are kept. After the
 //!   solve, any path that still enters a prop (a new contact the prediction missed) adds
 //!   its plane and the step is solved again: no vertex tunnels through a thin prop at any
@@ -161,8 +161,14 @@ struct PlaneContact {
     /// Normal force at the start of the step (lagged for friction), N.
     normal_force: f64,
     /// Where friction measures the slip from: the vertex's start of step, or, while it
-    /// sticks, the point it stuck at (`StepContacts::hold`).
+    /// sticks, the point it stuck at (`stick_point`).
     stick: DVec3,
+}
+
+/// Where friction measures vertex `v`'s slip from: the point it stuck at, if it sticks
+/// (`stuck`, by vertex), else its start of step.
+fn stick_point(stuck: &[Option<DVec3>], v: usize, start: &[DVec3]) -> DVec3 {
+    stuck.get(v).copied().flatten().unwrap_or(start[v])
 }
 
 /// Two parts of the cloth kept apart over one step: a vertex and a triangle, or two edges.
@@ -230,9 +236,11 @@ impl ContactModel {
 
 
     /// The contacts for a step from `start` (positions x_n) towards `predicted` (x_n + h v_n
-    /// or the BDF2 equivalent), with time step `h` and vertex masses.
+    /// or the BDF2 equivalent), with time step `h` and vertex masses; friction measures each
+    /// vertex's slip from where it stuck (`stuck`, by vertex, from
+    /// [`StepContacts::stuck_after`] of the step before), else from its start.
     /// The near-pair list `near` is renewed where it no longer covers the step.
-    pub fn begin_step(&self, cloth: Cloth, near: &mut NearPairs, start: &[DVec3], predicted: &[DVec3], h: f64) -> StepContacts {
+    pub fn begin_step(&self, cloth: Cloth, near: &mut NearPairs, start: &[DVec3], stuck: &[Option<DVec3>], predicted: &[DVec3], h: f64) -> StepContacts {
         let (fixed, mass) = (cloth.fixed, cloth.mass);
         let parallel = cloth.triangles.len() >= PARALLEL_TRIANGLES;
         let s = &self.settings;
@@ -249,7 +257,7 @@ impl ContactModel {
         let per_vertex = filter_in_order(start, parallel, |v, _| {
             let mut planes = Vec::new();
             if !fixed[v] {
-                self.add_planes(v, start[v], predicted[v], mass[v], h, &mut planes, false);
+                self.add_planes(v, start[v], predicted[v], stick_point(stuck, v, start), mass[v], h, &mut planes, false);
             }
             (!planes.is_empty()).then_some(planes)
         });
@@ -261,10 +269,11 @@ impl ContactModel {
     }
 
 
-    /// Adds vertex `v`'s planes: props within reach of its path, or entered by it. With
-    /// `only_missing`, only props the vertex has no plane with yet. Returns how many.
+    /// Adds vertex `v`'s planes: props within reach of its path from `a` to `b`, or entered
+    /// by it, friction measuring its slip from `stick`. With `only_missing`, only props the
+    /// vertex has no plane with yet. Returns how many.
     #[allow(clippy::too_many_arguments)]
-    fn add_planes(&self, v: usize, a: DVec3, b: DVec3, m: f64, h: f64, planes: &mut Vec<PlaneContact>, only_missing: bool) -> usize {
+    fn add_planes(&self, v: usize, a: DVec3, b: DVec3, stick: DVec3, m: f64, h: f64, planes: &mut Vec<PlaneContact>, only_missing: bool) -> usize {
         let s = &self.settings;
         let reach = s.thickness + (b - a).length();
         let mut added = 0;
@@ -285,7 +294,7 @@ impl ContactModel {
             if let Some(sp) = plane {
                 // The lagged normal force: what the penalty pushes with at the step's start.
                 let normal_force = stiffness * (s.thickness - near.distance).max(0.0);
-                planes.push(PlaneContact { vertex: v as u32, prop: p as u32, point: sp.point, normal: sp.normal, stiffness, normal_force, stick: a });
+                planes.push(PlaneContact { vertex: v as u32, prop: p as u32, point: sp.point, normal: sp.normal, stiffness, normal_force, stick });
                 added += 1;
             }
         }
@@ -295,7 +304,7 @@ impl ContactModel {
 
     /// After a solve from `start` to `end`: adds planes for paths that enter a prop without
     /// one. Returns how many were added (zero: the step stands).
-    pub fn add_missed(&self, contacts: &mut StepContacts, cloth: Cloth, start: &[DVec3], end: &[DVec3], h: f64) -> usize {
+    pub fn add_missed(&self, contacts: &mut StepContacts, cloth: Cloth, start: &[DVec3], stuck: &[Option<DVec3>], end: &[DVec3], h: f64) -> usize {
         let (fixed, mass) = (cloth.fixed, cloth.mass);
         let parallel = cloth.triangles.len() >= PARALLEL_TRIANGLES;
         let props = self.props.len();
@@ -316,7 +325,7 @@ impl ContactModel {
         });
         let mut added = 0;
         for v in missing {
-            added += self.add_planes(v, start[v], end[v], mass[v], h, &mut contacts.planes, true);
+            added += self.add_planes(v, start[v], end[v], stick_point(stuck, v, start), mass[v], h, &mut contacts.planes, true);
         }
         added
     }

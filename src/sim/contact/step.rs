@@ -19,8 +19,10 @@ impl StepContacts {
         self.pairs.len()
     }
 
-    /// Measures friction's slip from the points the vertices stuck at (`stuck`, by vertex,
-    /// from [`Self::stuck_after`] of the step before) instead of from this step's start.
+    /// After the step to `y`: where each vertex in contact with a prop sticks from for the
+    /// next step (None: not in contact). A vertex within ε of its stick point keeps it; one
+    /// beyond slides, and its stick point is dragged along, ε behind it along the slip, so
+    /// that friction decays from static to kinetic as the smoothed law does.
     ///
     /// Smoothed friction is viscous below the slip threshold ε: measured from each step's
     /// start, a sticking vertex under a sideways pull F slides on at slip_speed·F/(μN)
@@ -28,18 +30,6 @@ impl StepContacts {
     /// up to the slip speed, which is the bundled settle speed. Measured from where it
     /// stuck, the slip grows only until friction balances the pull (εF/(μN) < ε) and the
     /// vertex then stays: static friction holds, as Coulomb's does.
-    pub fn hold(&mut self, stuck: &[Option<DVec3>]) {
-        for c in &mut self.planes {
-            if let Some(&Some(point)) = stuck.get(c.vertex as usize) {
-                c.stick = point;
-            }
-        }
-    }
-
-    /// After the step to `y`: where each vertex in contact with a prop sticks from for the
-    /// next step (None: not in contact). A vertex within ε of its stick point keeps it; one
-    /// beyond slides, and its stick point is dragged along, ε behind it along the slip, so
-    /// that friction decays from static to kinetic as the smoothed law does.
     pub fn stuck_after(&self, y: &[DVec3], stuck: &mut Vec<Option<DVec3>>) {
         stuck.clear();
         stuck.resize(y.len(), None);

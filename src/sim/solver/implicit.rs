@@ -52,8 +52,7 @@ impl Integrator {
                 // The prediction includes gravity's pull over the step, so that contacts a
                 // falling cloth is about to make are there from the first iteration.
                 let predicted: Vec<DVec3> = (0..n).map(|i| inertial[i] + h * h * model.options.gravity).collect();
-                let mut contacts = contact.begin_step(model.cloth(), &mut self.near_pairs, &s.x, &predicted, h);
-                contacts.hold(&s.stuck);
+                let mut contacts = contact.begin_step(model.cloth(), &mut self.near_pairs, &s.x, &s.stuck, &predicted, h);
                 // Newton's path must start where the cloth is: jumping straight to the
                 // inertial guess could carry a vertex through a layer before any contact
                 // force acts. Start from x_n moved towards the guess as far as no cloth–cloth
@@ -72,8 +71,7 @@ impl Integrator {
                 for pass in 0..4 {
                     self.minimize(&step, Some(&contacts), &mut y, &mut report);
                     watch.restart();
-                    let missed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &y, h);
-                    contacts.hold(&s.stuck);
+                    let missed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &s.stuck, &y, h);
                     watch.contact();
                     if missed == 0 {
                         break;

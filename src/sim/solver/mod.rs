@@ -48,7 +48,7 @@ pub struct State {
     pub steps: u64,
     /// Previous positions and velocities (for BDF2), cleared when the history is invalid.
     pub(super) previous: Option<(Vec<DVec3>, Vec<DVec3>)>,
-    /// Where each vertex resting on a prop sticks from, by vertex (`StepContacts::hold`):
+    /// Where each vertex resting on a prop sticks from, by vertex (`StepContacts::stuck_after`):
     /// part of the state, so that a rejected step leaves it as it was.
     pub(super) stuck: Vec<Option<DVec3>>,
 }
