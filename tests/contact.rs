@@ -92,6 +92,47 @@ fn a_cloth_pulled_over_a_sharp_edge_stays_outside() {
     }
 }
 
+/// A 1 m strip hung by its middle over a 1 cm square rod: each half hangs 0.5 m, and the
+/// rod's two top edges turn the strip's tension T = ρ·w·L·g through 90°, pressing on the
+/// vertex row at each edge with √2·T, √2·L/e = 71 times the row's own weight (1 cm
+/// edges). With a soft penalty (c = 10 at 10 ms steps, k = c·m/Δt²) that load alone would
+/// hold those vertices (√2·L/e)·g·Δt²/c = 6.9 mm deep into a 2 mm layer, 4.9 mm inside
+/// the rod. Past the surface the penalty stiffens (`SURFACE_STIFFENING`): they stay
+/// within a tenth of the layer of it.
+#[test]
+fn a_strip_hung_over_a_rod_stays_outside_it() {
+    let (dt, stiffness, hanging, edge) = (0.01, 10.0, 0.5, 0.01);
+    let overrides = strings(&[
+        "cloth.length=1.0",
+        "cloth.width=0.04",
+        "cloth.position=[0.0, 0.0, 0.003]",
+        &format!("mesh.edge_length={edge}"),
+        &format!("solver.dt={dt}"),
+        &format!("contact.stiffness={stiffness}"),
+        "contact.self_collision=false",
+        "test.perturbation=0.0",
+        "test.support_size=[0.02, 0.02]", // read only by the drape coefficient, which this test does not use
+        "props=[{shape = 'box', size = [0.01, 0.2, 0.01], position = [0.0, 0.0, -0.005]}]",
+        "scene.duration=2.0",
+        "scene.settle_speed=1e-9",
+    ]);
+    let mut scene = build("tablecloth", &overrides);
+    let thickness = scene.config.contact.thickness;
+    let g = rosette::physics::STANDARD_GRAVITY;
+    let layer_alone = std::f64::consts::SQRT_2 * hanging / edge * g * dt * dt / stiffness - thickness;
+    assert!(layer_alone > thickness, "the test needs a load that would take the layer's penalty past the surface: {layer_alone} m");
+    let (metrics, error) = run_scene(&mut scene, "rod", RunOptions::default());
+    assert!(error.is_none(), "{error:?}");
+    let penetration = metrics.max_penetration.unwrap();
+    assert!(penetration < 0.1 * thickness, "{penetration} m inside the rod (the layer's penalty alone: {layer_alone} m)");
+    // It hangs on the rod: both ends near 0.5 m below it, none fallen off.
+    let x = &scene.state.x;
+    for side in [-1.0, 1.0] {
+        let lowest = x.iter().filter(|p| p.x * side > 0.0).map(|p| p.z).fold(f64::INFINITY, f64::min);
+        assert!(lowest < -0.4 && lowest > -0.6, "the {side} half's end is at {lowest} m");
+    }
+}
+
 /// A stiff square on a plane tilted by θ: with μ_s = 0.5 and μ_k = 0.4 it must stay put at
 /// 20° (tan θ = 0.36 < μ_s) and slide at 35° (tan θ = 0.70 > μ_s) with the block-on-incline
 /// acceleration g(sin θ − μ_k cos θ) = 2.41 m/s².

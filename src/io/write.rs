@@ -212,7 +212,10 @@ mod tests {
         whole(&path, b"new").unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "new");
         let dir = path.parent().unwrap();
-        let stray = std::fs::read_dir(dir).unwrap().flatten().any(|e| e.file_name().to_string_lossy().contains("rosette-write") && e.file_name().to_string_lossy().ends_with(".tmp"));
+        // This file's own staging files only: the other tests here stage theirs in the
+        // same folder at the same time.
+        let staging = format!(".{}.", path.file_name().unwrap().to_string_lossy());
+        let stray = std::fs::read_dir(dir).unwrap().flatten().any(|e| e.file_name().to_string_lossy().starts_with(&staging) && e.file_name().to_string_lossy().ends_with(".tmp"));
         assert!(!stray, "no staging file is left behind");
         std::fs::remove_file(&path).ok();
     }

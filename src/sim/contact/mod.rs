@@ -156,13 +156,56 @@ struct PlaneContact {
     prop: u32,
     point: DVec3,
     normal: DVec3,
-    /// Penalty stiffness, N/m.
+    /// Penalty stiffness in the layer, N/m.
     stiffness: f64,
+    /// Its stiffness past the surface, N/m: `SURFACE_STIFFENING` times the layer's for a
+    /// vertex that starts the step in the layer, the layer's for one arriving.
+    beyond: f64,
     /// Normal force at the start of the step (lagged for friction), N.
     normal_force: f64,
     /// Where friction measures the slip from: the vertex's start of step, or, while it
     /// sticks, the point it stuck at (`stick_point`).
     stick: DVec3,
+}
+
+/// How much stiffer the penalty is past a prop's surface than in its contact layer, for a
+/// vertex that starts the step in the layer.
+///
+/// The layer stands in for the cloth's own thickness: a soft penalty there keeps a resting
+/// vertex's Newton system well conditioned, and a vertex settles into it by its load over
+/// c·m/Δt² (c = `contact.stiffness`), a fraction of the layer for a vertex carrying its own
+/// weight. A vertex that carries much more, a shoulder holding up a heavy dress while its
+/// seams close, was pushed on through the layer into the form: the denim shift dress went
+/// 1.9 mm into its form on the exact path, 0.008 mm with this (docs/performance-log.md,
+/// "2026-12-04, late evening"). A vertex arriving from outside the layer keeps the layer's
+/// stiffness: its plane, the tangent where it starts, stands for the surface only near
+/// there, and one that passes a corner of a mesh prop within the step may lie below that
+/// plane yet outside the prop (applied to every plane, the stiffening threw such vertices
+/// back and moved the fast path's garments off their path).
+pub const SURFACE_STIFFENING: f64 = 100.0;
+
+impl PlaneContact {
+    /// The penalty's energy, force along the normal and stiffness for vertex position `y`
+    /// against a layer `thickness` thick: ½k·g² for a gap g = thickness − n·(y − point) into
+    /// the layer, and past the surface (g > thickness) the stiffness `beyond` on the depth
+    /// beyond it, so that the energy's gradient is continuous.
+    fn penalty(&self, y: DVec3, thickness: f64) -> (f64, f64, f64) {
+        penalty(thickness - self.normal.dot(y - self.point), thickness, self.stiffness, self.beyond)
+    }
+}
+
+/// The penalty of stiffness `k` in a layer `thickness` thick and `beyond` past it (N/m)
+/// at a gap `gap` (m) into the layer: energy, force and stiffness (`PlaneContact::penalty`).
+fn penalty(gap: f64, thickness: f64, k: f64, beyond: f64) -> (f64, f64, f64) {
+    if gap <= 0.0 {
+        return (0.0, 0.0, 0.0);
+    }
+    let depth = gap - thickness;
+    if depth <= 0.0 {
+        return (0.5 * k * gap * gap, k * gap, k);
+    }
+    let extra = beyond - k;
+    (0.5 * k * gap * gap + 0.5 * extra * depth * depth, k * gap + extra * depth, beyond)
 }
 
 /// Where friction measures vertex `v`'s slip from: the point it stuck at, if it sticks
@@ -293,8 +336,13 @@ impl ContactModel {
             };
             if let Some(sp) = plane {
                 // The lagged normal force: what the penalty pushes with at the step's start.
-                let normal_force = stiffness * (s.thickness - near.distance).max(0.0);
-                planes.push(PlaneContact { vertex: v as u32, prop: p as u32, point: sp.point, normal: sp.normal, stiffness, normal_force, stick });
+                // The plane is the surface's tangent at the step's start: past it is inside
+                // the prop for a vertex resting there, which may slide little in a step; a
+                // vertex arriving from outside the layer may go round a corner of the
+                // prop within the step, and keeps the layer's stiffness throughout.
+                let beyond = if near.distance < s.thickness { SURFACE_STIFFENING * stiffness } else { stiffness };
+                let normal_force = penalty(s.thickness - near.distance, s.thickness, stiffness, beyond).1;
+                planes.push(PlaneContact { vertex: v as u32, prop: p as u32, point: sp.point, normal: sp.normal, stiffness, beyond, normal_force, stick });
                 added += 1;
             }
         }

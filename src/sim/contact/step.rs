@@ -77,10 +77,7 @@ impl StepContacts {
         let mut e = 0.0;
         for c in &self.planes {
             let i = c.vertex as usize;
-            let gap = self.thickness - c.normal.dot(y[i] - c.point);
-            if gap > 0.0 {
-                e += 0.5 * c.stiffness * gap * gap;
-            }
+            e += c.penalty(y[i], self.thickness).0;
             if c.normal_force > 0.0 {
                 let u = y[i] - c.stick;
                 let slip = (u - u.dot(c.normal) * c.normal).length();
@@ -102,11 +99,9 @@ impl StepContacts {
         let mut e = 0.0;
         for c in &self.planes {
             let i = c.vertex as usize;
-            let gap = self.thickness - c.normal.dot(y[i] - c.point);
-            if gap > 0.0 {
-                e += 0.5 * c.stiffness * gap * gap;
-                g[i] -= c.stiffness * gap * c.normal;
-            }
+            let (energy, force, _) = c.penalty(y[i], self.thickness);
+            e += energy;
+            g[i] -= force * c.normal;
             if c.normal_force > 0.0 {
                 let u = y[i] - c.stick;
                 let t = u - u.dot(c.normal) * c.normal;
@@ -137,10 +132,7 @@ impl StepContacts {
     pub fn add_gradient(&self, y: &[DVec3], g: &mut [DVec3], fixed: &[bool]) {
         for c in &self.planes {
             let i = c.vertex as usize;
-            let gap = self.thickness - c.normal.dot(y[i] - c.point);
-            if gap > 0.0 {
-                g[i] -= c.stiffness * gap * c.normal;
-            }
+            g[i] -= c.penalty(y[i], self.thickness).1 * c.normal;
             if c.normal_force > 0.0 {
                 let u = y[i] - c.stick;
                 let t = u - u.dot(c.normal) * c.normal;
@@ -170,10 +162,7 @@ impl StepContacts {
     pub fn add_hessian(&self, y: &[DVec3], k: &mut BlockCsr) {
         for c in &self.planes {
             let i = c.vertex as usize;
-            let mut block = DMat3::ZERO;
-            if self.thickness - c.normal.dot(y[i] - c.point) > 0.0 {
-                block += c.stiffness * outer(c.normal, c.normal);
-            }
+            let mut block = c.penalty(y[i], self.thickness).2 * outer(c.normal, c.normal);
             if c.normal_force > 0.0 {
                 // λF(s) of the slip s = |u_T|: curvature λF'(s)/s across the slip and λF''(s)
                 // along it. Sticking (s ≤ ε), F is quadratic and both are μ_s/ε. Sliding,
@@ -215,10 +204,7 @@ impl StepContacts {
     pub fn add_isotropic_stiffness(&self, y: &[DVec3], diagonal: &mut [f64]) {
         for c in &self.planes {
             let i = c.vertex as usize;
-            let mut k: f64 = 0.0;
-            if self.thickness - c.normal.dot(y[i] - c.point) > 0.0 {
-                k = c.stiffness;
-            }
+            let mut k = c.penalty(y[i], self.thickness).2;
             if c.normal_force > 0.0 {
                 let u = y[i] - c.stick;
                 let slip = (u - u.dot(c.normal) * c.normal).length().max(self.slip);
