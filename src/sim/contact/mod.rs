@@ -182,7 +182,7 @@ struct PlaneContact {
 /// there, and one that passes a corner of a mesh prop within the step may lie below that
 /// plane yet outside the prop (applied to every plane, the stiffening threw such vertices
 /// back and moved the fast path's garments off their path).
-pub const SURFACE_STIFFENING: f64 = 100.0;
+const SURFACE_STIFFENING: f64 = 100.0;
 
 impl PlaneContact {
     /// The penalty's energy, force along the normal and stiffness for vertex position `y`
@@ -191,6 +191,13 @@ impl PlaneContact {
     /// beyond it, so that the energy's gradient is continuous.
     fn penalty(&self, y: DVec3, thickness: f64) -> (f64, f64, f64) {
         penalty(thickness - self.normal.dot(y - self.point), thickness, self.stiffness, self.beyond)
+    }
+
+    /// The vertex's slip at position `y`: its displacement from the stick point, tangent
+    /// to the plane.
+    fn slip(&self, y: DVec3) -> DVec3 {
+        let u = y - self.stick;
+        u - u.dot(self.normal) * self.normal
     }
 }
 

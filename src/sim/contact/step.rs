@@ -38,8 +38,7 @@ impl StepContacts {
                 continue;
             }
             let i = c.vertex as usize;
-            let u = y[i] - c.stick;
-            let t = u - u.dot(c.normal) * c.normal;
+            let t = c.slip(y[i]);
             let slip = t.length();
             stuck[i] = Some(if slip <= self.slip { c.stick } else { y[i] - self.slip / slip * t });
         }
@@ -79,8 +78,7 @@ impl StepContacts {
             let i = c.vertex as usize;
             e += c.penalty(y[i], self.thickness).0;
             if c.normal_force > 0.0 {
-                let u = y[i] - c.stick;
-                let slip = (u - u.dot(c.normal) * c.normal).length();
+                let slip = c.slip(y[i]).length();
                 e += c.normal_force * self.friction(slip).0;
             }
         }
@@ -103,8 +101,7 @@ impl StepContacts {
             e += energy;
             g[i] -= force * c.normal;
             if c.normal_force > 0.0 {
-                let u = y[i] - c.stick;
-                let t = u - u.dot(c.normal) * c.normal;
+                let t = c.slip(y[i]);
                 let slip = t.length();
                 let (value, slope) = self.friction(slip);
                 e += c.normal_force * value;
@@ -134,8 +131,7 @@ impl StepContacts {
             let i = c.vertex as usize;
             g[i] -= c.penalty(y[i], self.thickness).1 * c.normal;
             if c.normal_force > 0.0 {
-                let u = y[i] - c.stick;
-                let t = u - u.dot(c.normal) * c.normal;
+                let t = c.slip(y[i]);
                 let slip = t.length();
                 if slip > 0.0 {
                     g[i] += c.normal_force * self.friction(slip).1 * t / slip;
@@ -169,8 +165,7 @@ impl StepContacts {
                 // F'' < 0 as μ decays to μ_k; 0 is used there. λF'(s)/s along the slip would
                 // be up to μ_s/ε·λ, many times a resting vertex's inertia at a small slip
                 // threshold, and with it Newton creeps along a sliding vertex's path.
-                let u = y[i] - c.stick;
-                let t = u - u.dot(c.normal) * c.normal;
+                let t = c.slip(y[i]);
                 let slip = t.length();
                 let tangent = DMat3::IDENTITY - outer(c.normal, c.normal);
                 let (_, dfriction) = self.friction(slip.max(self.slip));
@@ -206,8 +201,7 @@ impl StepContacts {
             let i = c.vertex as usize;
             let mut k = c.penalty(y[i], self.thickness).2;
             if c.normal_force > 0.0 {
-                let u = y[i] - c.stick;
-                let slip = (u - u.dot(c.normal) * c.normal).length().max(self.slip);
+                let slip = c.slip(y[i]).length().max(self.slip);
                 k = k.max(c.normal_force * self.friction(slip).1 / slip);
             }
             diagonal[i] += k;
