@@ -133,6 +133,83 @@ fn a_strip_hung_over_a_rod_stays_outside_it() {
     }
 }
 
+/// A strip sliding without friction down one side of a V-shaped valley (a closed OBJ mesh
+/// prop, sides at ±26.6°) and up the other, through its crease and back, at 24 ms steps:
+/// each step moves a vertex up to 4 cm, and a vertex whose contact plane is the slope it
+/// started on ends the step past the crease, below the far slope's surface, unless that
+/// plane is renewed where it ended (without the renewal it went 11 mm into the valley).
+/// The contact model holds every vertex outside the prop at any step size.
+#[test]
+fn a_strip_sliding_through_a_valley_stays_outside_it() {
+    // The valley's cross-section in (x, z), extruded along y from −0.2 to 0.2 m: its top
+    // runs from (−0.3, 0.15) down to the crease at the origin and up to (0.3, 0.15).
+    let section = [(-0.3, 0.15), (0.0, 0.0), (0.3, 0.15), (0.3, -0.1), (-0.3, -0.1)];
+    let mut obj = String::new();
+    for y in [-0.2, 0.2] {
+        for (x, z) in section {
+            obj += &format!("v {x} {y} {z}\n");
+        }
+    }
+    // End caps (the section's points are clockwise in (x, z), so these face out), then the
+    // five sides.
+    let mut faces: Vec<[usize; 3]> = Vec::new();
+    for [a, b, c] in [[5, 4, 2], [5, 2, 1], [4, 3, 2]] {
+        faces.push([a, b, c]);
+        faces.push([c + 5, b + 5, a + 5]);
+    }
+    for a in 1..=5 {
+        let b = a % 5 + 1;
+        faces.push([a, b, b + 5]);
+        faces.push([a, b + 5, a + 5]);
+    }
+    for [a, b, c] in faces {
+        obj += &format!("f {a} {b} {c}\n");
+    }
+    let file = std::env::temp_dir().join(format!("rosette-valley-{}.obj", std::process::id()));
+    std::fs::write(&file, obj).unwrap();
+    let overrides = strings(&[
+        "cloth.length=0.06",
+        "cloth.width=0.03",
+        "cloth.position=[-0.15, 0.0, 0.105]",
+        "mesh.edge_length=0.01",
+        "contact.self_collision=false",
+        "contact.friction_static=0.0",
+        "contact.friction_kinetic=0.0",
+        "solver.damping=0",
+        "solver.dt=0.024",
+        "test.perturbation=0.0",
+        "test.support_size=[0.02, 0.02]", // read only by the drape coefficient, which this test does not use
+        &format!("props=[{{shape = 'mesh', file = '{}'}}]", file.display()),
+        "scene.duration=1.5",
+        "scene.settle_speed=1e-9",
+    ]);
+    let mut scene = build("tablecloth", &overrides);
+    let thickness = scene.config.contact.thickness;
+    let mut crossings = 0;
+    let mut side = -1.0;
+    let mut deepest = 0.0f64;
+    while scene.state.time < 1.5 - 1e-9 {
+        scene.step().unwrap_or_else(|e| panic!("{e}"));
+        let centre = scene.state.x.iter().map(|p| p.x).sum::<f64>() / scene.state.x.len() as f64;
+        if centre * side < 0.0 {
+            crossings += 1;
+            side = -side;
+        }
+        // Depth below the valley's surface z = |x|/2 from its two slopes' planes (the strip
+        // stays over its top): a point below one plane is inside, as deep as it is below
+        // that plane; one below both is as deep as it is below the nearer.
+        for p in &scene.state.x {
+            let below = |s: f64| (0.5 * s * p.x - p.z) / 1.25f64.sqrt();
+            let (left, right) = (below(-1.0), below(1.0));
+            let depth = if left > 0.0 && right > 0.0 { left.min(right) } else { left.max(right) };
+            deepest = deepest.max(depth);
+        }
+    }
+    std::fs::remove_file(&file).ok();
+    assert!(crossings >= 2, "the strip crossed the crease {crossings} times");
+    assert!(deepest < 0.1 * thickness, "{deepest} m inside the valley");
+}
+
 /// A stiff square on a plane tilted by θ: with μ_s = 0.5 and μ_k = 0.4 it must stay put at
 /// 20° (tan θ = 0.36 < μ_s) and slide at 35° (tan θ = 0.70 > μ_s) with the block-on-incline
 /// acceleration g(sin θ − μ_k cos θ) = 2.41 m/s².

@@ -17,8 +17,9 @@
 //!   for ever (`StepContacts::stuck_after`). Because both are energies, the line search, the energy
 //!   checks and the unconditional stability of the implicit step are kept. After the
 //!   solve, any path that still enters a prop (a new contact the prediction missed) adds
-//!   its plane and the step is solved again: no vertex tunnels through a thin prop at any
-//!   step size.
+//!   its plane, and a vertex that slid past its plane's reach into a concave part of a
+//!   prop has its plane renewed where it ended (`ContactModel::refresh_planes`); the step
+//!   is then solved again: no vertex tunnels through a thin prop at any step size.
 //! - The explicit integrator takes contact at the velocity level after its update: a
 //!   vertex that ends inside the thickness layer, or whose path entered the prop, is put
 //!   back on the layer, loses its inward normal velocity, and its tangential velocity is
@@ -184,6 +185,12 @@ struct PlaneContact {
 /// back and moved the fast path's garments off their path).
 const SURFACE_STIFFENING: f64 = 100.0;
 
+/// How deep inside its prop, as a share of the contact layer, a vertex may end a step
+/// before its plane is renewed where it is (`ContactModel::refresh_planes`): a fiftieth of
+/// the 2 mm layer is 0.04 mm, under any fabric's thickness and far under what a viewer
+/// can see.
+const REFRESH_DEPTH_SHARE: f64 = 0.02;
+
 impl PlaneContact {
     /// The penalty's energy, force along the normal and stiffness for vertex position `y`
     /// against a layer `thickness` thick: ½k·g² for a gap g = thickness − n·(y − point) into
@@ -235,7 +242,8 @@ struct SelfPair {
 pub struct ContactStats {
     /// Deepest any vertex has been inside a prop at the end of a step, m.
     pub max_penetration: f64,
-    /// Steps solved again because a path entered a prop the prediction missed.
+    /// Steps solved again because a path entered a prop the prediction missed, or a
+    /// vertex ended inside a prop it had a plane with.
     pub resolves: u64,
     /// Vertex–triangle or edge–edge crossings stopped by impact zones.
     pub impacts: u64,
@@ -385,6 +393,40 @@ impl ContactModel {
         added
     }
 
+
+    /// After a solve ending at `end`: renews the plane of each vertex that ended more than
+    /// `REFRESH_DEPTH_SHARE` of the layer inside its prop, to the surface's tangent at its
+    /// closest point there, held with the stiffness past the surface of a resting vertex.
+    /// Returns how many were renewed (zero: the step stands).
+    ///
+    /// A plane is the surface's tangent where the vertex started the step. Over a convex
+    /// part of a prop the prop lies behind that plane, but a vertex sliding within a step
+    /// into a concave part (a valley, or across an inward fold between a mesh prop's
+    /// facets) can pass the surface while still in front of its plane: the shift dress at
+    /// 24 ms steps went 0.12 mm into its form that way, a strip sliding through a valley
+    /// 11 mm (`tests/contact.rs`; docs/performance-log.md, "2026-12-04, night"). The solve
+    /// is repeated from where it stopped with the plane taken where the vertex is: a
+    /// sequential linearisation of the prop's surface.
+    pub fn refresh_planes(&self, contacts: &mut StepContacts, cloth: Cloth, end: &[DVec3]) -> usize {
+        let parallel = cloth.triangles.len() >= PARALLEL_TRIANGLES;
+        let limit = REFRESH_DEPTH_SHARE * self.settings.thickness;
+        let renewed = filter_in_order(&contacts.planes, parallel, |i, c| {
+            let y = end[c.vertex as usize];
+            let prop = c.prop as usize;
+            if !self.near_bounds(prop, y, y, 0.0) {
+                return None;
+            }
+            let sp = self.props[prop].surface_point(y);
+            (sp.distance < -limit).then_some((i, sp))
+        });
+        for &(i, sp) in &renewed {
+            let c = &mut contacts.planes[i];
+            c.point = sp.point;
+            c.normal = sp.normal;
+            c.beyond = SURFACE_STIFFENING * c.stiffness;
+        }
+        renewed.len()
+    }
 
     /// Deepest penetration of any vertex into any prop, m (zero when all are outside).
     pub fn penetration(&self, x: &[DVec3], fixed: &[bool]) -> f64 {

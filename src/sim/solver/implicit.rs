@@ -71,7 +71,13 @@ impl Integrator {
                 for pass in 0..4 {
                     self.minimize(&step, Some(&contacts), &mut y, &mut report);
                     watch.restart();
-                    let missed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &s.stuck, &y, h);
+                    let mut missed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &s.stuck, &y, h);
+                    if pass < 2 {
+                        // Planes are renewed twice at most: a vertex still inside after
+                        // that is left to the penetration measure, not to the step's
+                        // convergence.
+                        missed += contact.refresh_planes(&mut contacts, model.cloth(), &y);
+                    }
                     watch.contact();
                     if missed == 0 {
                         break;
