@@ -495,10 +495,12 @@ const PARALLEL_TRIANGLES: usize = 4096;
 /// What `keep(i, &items[i])` returns, in the order of i (if `parallel`, fixed chunks on
 /// rayon's threads). Both paths run the same loop over a chunk, which `keep` is inlined
 /// into: with an iterator adapter on each path it is not, and the filters, run on every
-/// pair every step, are slower.
+/// pair every step, are slower. The chunks are small enough for the threads to share the
+/// items evenly (in chunks of 4 096 a 10k garment's 5 247 vertices went 4 096 to one
+/// thread and 1 151 to the other); what is kept, and its order, do not depend on them.
 fn filter_in_order<T: Sync, U: Send>(items: &[T], parallel: bool, keep: impl Fn(usize, &T) -> Option<U> + Sync) -> Vec<U> {
     use rayon::prelude::*;
-    const CHUNK: usize = 4096;
+    const CHUNK: usize = 1024;
     let filter = |first: usize, out: &mut Vec<U>| {
         let end = if parallel { (first + CHUNK).min(items.len()) } else { items.len() };
         for (i, item) in items[first..end].iter().enumerate() {
