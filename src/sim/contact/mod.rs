@@ -160,7 +160,8 @@ struct PlaneContact {
     /// Penalty stiffness in the layer, N/m.
     stiffness: f64,
     /// Its stiffness past the surface, N/m: `SURFACE_STIFFENING` times the layer's for a
-    /// vertex that starts the step in the layer, the layer's for one arriving.
+    /// vertex that starts the step in the layer or whose plane was renewed where it ended
+    /// inside the prop (`ContactModel::refresh_planes`), the layer's for one arriving.
     beyond: f64,
     /// Normal force at the start of the step (lagged for friction), N.
     normal_force: f64,

@@ -67,19 +67,20 @@ impl Integrator {
                     }
                 }
                 watch.contact();
-                // Solve; a path that enters a prop without a plane adds one and solves again.
+                // Solve; a path that enters a prop without a plane adds one, a vertex that
+                // ended inside a prop renews its plane there, and the step is solved again.
                 for pass in 0..4 {
                     self.minimize(&step, Some(&contacts), &mut y, &mut report);
                     watch.restart();
-                    let mut missed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &s.stuck, &y, h);
+                    let mut changed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &s.stuck, &y, h);
                     if pass < 2 {
                         // Planes are renewed twice at most: a vertex still inside after
                         // that is left to the penetration measure, not to the step's
                         // convergence.
-                        missed += contact.refresh_planes(&mut contacts, model.cloth(), &y);
+                        changed += contact.refresh_planes(&mut contacts, model.cloth(), &y);
                     }
                     watch.contact();
-                    if missed == 0 {
+                    if changed == 0 {
                         break;
                     }
                     self.contact_stats.resolves += 1;
