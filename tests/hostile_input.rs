@@ -257,6 +257,15 @@ fn zero_newton_or_cg_iterations_are_refused_instead_of_reported_stable() {
     assert_refused(&["run", "cantilever", "--set", "solver.newton.cg_max_iterations=0"], &["solver.newton.cg_max_iterations"]);
 }
 
+/// Recycled directions cost memory and a product each per solve: a count no solve could
+/// repay is refused, naming the key and the limit; a negative one is not a count.
+#[test]
+fn too_many_recycled_directions_are_refused() {
+    assert_refused(&["run", "cantilever", "--set", "solver.newton.recycled_directions=100000"], &["solver.newton.recycled_directions", "at most 32"]);
+    assert_refused(&["run", "skirt-circle", "--fast", "--set", "solver.fast.recycled_directions=33"], &["solver.fast.recycled_directions", "at most 32"]);
+    assert_refused(&["run", "cantilever", "--set", "solver.newton.recycled_directions=-1"], &["solver.newton.recycled_directions"]);
+}
+
 #[test]
 fn a_tensile_curve_of_slope_1e300_is_refused_instead_of_giving_nan_measures() {
     assert_refused(&["run", "tensile-warp", "--set", "fabric.tensile_warp=[[0,0],[0.01,1e300]]"], &["fabric.tensile_warp", "slope"]);

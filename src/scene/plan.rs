@@ -117,7 +117,7 @@ impl RunPlan {
             let _ = writeln!(text, "  step: {}, dt {} s{step}, damping {} 1/s{}", s.integrator.name(), s.dt, s.damping, if s.adaptive.is_some() { ", adaptive" } else { "" });
             let _ = writeln!(
                 text,
-                "  {}: at most {} iterations, tolerance {} of the mean edge{}, preconditioner {}{}, indefinite {}, retry exact {}",
+                "  {}: at most {} iterations, tolerance {} of the mean edge{}, preconditioner {}{}, indefinite {}, retry exact {}{}",
                 n.minimizer.name(),
                 n.max_iterations,
                 n.tolerance,
@@ -130,6 +130,7 @@ impl RunPlan {
                 },
                 key_name(&n.indefinite),
                 n.retry_exact,
+                if n.recycled_directions > 0 { format!(", CG deflated by the last {} directions", n.recycled_directions) } else { String::new() },
             );
             if !c.props.is_empty() || c.contact.self_collision {
                 let factor = c.contact.stiffness / scene.contact.stiffness;
@@ -238,6 +239,11 @@ pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
     // nodes instead of the exact path's 5 and the circle skirt did not settle in 6 s
     // (docs/performance-log.md).
     level.solver.newton.error_share = if kind == Design::Motion { fast.motion_error_share } else { fast.error_share };
+    // A garment coming to rest repeats its slow swing from step to step: its solves are
+    // deflated by the last Newton directions (docs/fast-path.md, item 7).
+    if kind == Design::Garment {
+        level.solver.newton.recycled_directions = fast.recycled_directions;
+    }
     // A cloth landing on a prop buckles in most iterations of its landing steps: once
     // the exact matrix has failed in a step, the rest of the step is solved on the
     // bounded one instead of trying the exact one first again (docs/fast-path.md).
@@ -327,6 +333,12 @@ mod tests {
         assert!((level.contact.stiffness - config.contact.stiffness * ratio * ratio).abs() < 1e-9 * level.contact.stiffness);
         assert_eq!(level.solver.newton.preconditioner, PreconditionerChoice::IncompleteCholesky);
         assert_eq!(level.solver.newton.error_share, config.solver.fast.error_share);
+        assert_eq!(level.solver.newton.recycled_directions, config.solver.fast.recycled_directions);
+        assert!(plan.describe(&config).contains("deflated by the last 8 directions"), "{}", plan.describe(&config));
+        // Only garments: the exact path and the other designs keep plain CG.
+        assert_eq!(config.solver.newton.recycled_directions, 0);
+        let (_, drape) = super::tests::plan("cusick-drape", &["solver.path=fast"]);
+        assert!(drape.levels.iter().all(|l| l.config.solver.newton.recycled_directions == 0));
     }
 
     #[test]

@@ -345,11 +345,17 @@ pub struct FastSettings {
     /// and leaves the swing's period unchanged to 2e-5, while vertices may sink up to 0.8
     /// of the contact layer where 0.1 let none in (docs/fast-path.md, item 6).
     pub motion_error_share: f64,
+    /// How many of the last Newton directions deflate a garment's CG solves on meshes whose
+    /// incomplete factor is split (`solver.newton.recycled_directions`): a garment coming
+    /// to rest on its form repeats its slow swing from step to step, and the split factor
+    /// resolved it in 100–190 CG iterations a solve near the end (docs/performance-log.md,
+    /// "2026-12-05").
+    pub recycled_directions: usize,
 }
 
 impl Default for FastSettings {
     fn default() -> Self {
-        Self { dt: 0.064, drop_dt: 0.016, garment_dt: 0.024, coarsest_edge_share: 0.5, error_share: 0.1, motion_error_share: 0.3 }
+        Self { dt: 0.064, drop_dt: 0.016, garment_dt: 0.024, coarsest_edge_share: 0.5, error_share: 0.1, motion_error_share: 0.3, recycled_directions: 8 }
     }
 }
 

@@ -189,6 +189,8 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
         return Err(invalid("solver.damping", format!("solver.damping = {} 1/s stops any motion within a billionth of a step; use at most {}", short(solver.damping), short(most))));
     }
     let n = &solver.newton;
+    /// Beyond a few tens the directions' products cost more than any solve they could save.
+    const MAX_RECYCLED_DIRECTIONS: usize = 32;
     if n.max_iterations == 0 {
         return Err(invalid("solver.newton.max_iterations", format!("solver.newton.max_iterations must be at least 1 (default {}): with none, no step is solved", crate::sim::solver::DEFAULT_MAX_ITERATIONS)));
     }
@@ -205,6 +207,14 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
             "solver.newton.error_share",
             format!("solver.newton.error_share = {} must lie in [0, 1): a share of the step's local error (0: off)", short(n.error_share)),
         ));
+    }
+    for (key, count, default) in [("solver.newton.recycled_directions", n.recycled_directions, 0), ("solver.fast.recycled_directions", solver.fast.recycled_directions, 8)] {
+        if count > MAX_RECYCLED_DIRECTIONS {
+            return Err(invalid(
+                key,
+                format!("{key} = {count} is too many: each direction costs a matrix product per linear solve and two passes per CG iteration; use at most {MAX_RECYCLED_DIRECTIONS} (default {default}, 0: off)"),
+            ));
+        }
     }
     let fast = &solver.fast;
     positive("solver.fast.dt", fast.dt)?;

@@ -59,6 +59,11 @@ pub(super) fn part_count(n: usize) -> usize {
     if n < PART_VERTICES { 1 } else { (n / PART_VERTICES).max(2) }
 }
 
+/// Whether an incomplete factor over `n` vertices is split into parts.
+pub fn factor_is_split(n: usize) -> bool {
+    part_count(n) > 1
+}
+
 /// The factor of the diagonal block of rows `start..start + pivot_inverse.len()`.
 struct FactorPart {
     start: usize,

@@ -17,9 +17,9 @@ mod system;
 #[cfg(test)]
 mod tests;
 
-pub use cg::{CgReport, pcg};
+pub use cg::{CgReport, Recycled, pcg, pcg_deflated};
 pub use direct::{DirectFactor, DirectPattern};
-pub use incomplete::{FactorPattern, IncompleteCholesky};
+pub use incomplete::{FactorPattern, IncompleteCholesky, factor_is_split};
 pub use multigrid::Multigrid;
 pub use preconditioner::Preconditioner;
 pub use scalar_factor::{ScalarFactor, ScalarPattern};

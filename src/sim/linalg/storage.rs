@@ -45,7 +45,7 @@ fn pattern(n: usize, pairs: impl Iterator<Item = (u32, u32)>) -> (Vec<u32>, Vec<
 
 /// Below this many rows a product runs on the calling thread: spreading a few thousand
 /// rows over threads costs more in scheduling than it saves.
-const PARALLEL_ROWS: usize = 4096;
+pub(super) const PARALLEL_ROWS: usize = 4096;
 
 /// Calls `f(row, &mut y[row])` for every row, in chunks over rayon's pool when `y` is long.
 /// The chunks are small enough that the threads share the rows evenly: in chunks of 1 024
@@ -59,6 +59,22 @@ pub(super) fn for_rows(y: &mut [DVec3], f: impl Fn(usize, &mut DVec3) + Sync) {
     } else {
         y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, chunk)| {
             for (i, out) in chunk.iter_mut().enumerate() {
+                f(c * CHUNK + i, out);
+            }
+        });
+    }
+}
+
+/// As [`for_rows`] for `k` vectors stored side by side (`y[row * k + j]` is row `row` of
+/// the `j`-th): calls `f(row, &mut y[row * k..row * k + k])` for every row.
+pub(super) fn for_row_groups(y: &mut [DVec3], k: usize, f: impl Fn(usize, &mut [DVec3]) + Sync) {
+    use rayon::prelude::*;
+    const CHUNK: usize = 256;
+    if y.len() < PARALLEL_ROWS * k {
+        y.chunks_mut(k).enumerate().for_each(|(row, out)| f(row, out));
+    } else {
+        y.par_chunks_mut(CHUNK * k).enumerate().for_each(|(c, chunk)| {
+            for (i, out) in chunk.chunks_mut(k).enumerate() {
                 f(c * CHUNK + i, out);
             }
         });
@@ -103,6 +119,19 @@ impl BlockCsr {
         self.values[s..e].iter().zip(&self.cols[s..e]).fold(DVec3::ZERO, |acc, (m, &c)| acc + *m * x[c as usize])
     }
 
+    /// Row `row` of A X added to `out`, for the `out.len()` vectors of `x` stored side by
+    /// side (`x[col * k + j]`): the row's blocks read once for all of them.
+    #[inline]
+    pub(super) fn row_product_add_many(&self, row: usize, x: &[DVec3], out: &mut [DVec3]) {
+        let k = out.len();
+        let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
+        for (m, &c) in self.values[s..e].iter().zip(&self.cols[s..e]) {
+            for (o, v) in out.iter_mut().zip(&x[c as usize * k..c as usize * k + k]) {
+                *o += *m * *v;
+            }
+        }
+    }
+
     pub fn vertex_count(&self) -> usize {
         self.row_start.len() - 1
     }
@@ -145,6 +174,18 @@ impl ScalarCsr {
     pub(super) fn row_product(&self, row: usize, x: &[DVec3]) -> DVec3 {
         let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
         self.values[s..e].iter().zip(&self.cols[s..e]).fold(DVec3::ZERO, |acc, (&v, &c)| acc + v * x[c as usize])
+    }
+
+    /// As [`BlockCsr::row_product_add_many`].
+    #[inline]
+    pub(super) fn row_product_add_many(&self, row: usize, x: &[DVec3], out: &mut [DVec3]) {
+        let k = out.len();
+        let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
+        for (&v, &c) in self.values[s..e].iter().zip(&self.cols[s..e]) {
+            for (o, xv) in out.iter_mut().zip(&x[c as usize * k..c as usize * k + k]) {
+                *o += v * *xv;
+            }
+        }
     }
 
     pub fn diagonal(&self, row: u32) -> f64 {

@@ -8,7 +8,7 @@ use crate::sim::linalg::BlockCsr;
 use crate::sim::model::CompressedEdges;
 use super::settings::GlobalPreconditioner;
 use super::Integrator;
-use crate::sim::linalg::{CgReport, DirectFactor, DirectPattern, FactorPattern, Multigrid, Preconditioner, SystemMatrix, pcg};
+use crate::sim::linalg::{CgReport, DirectFactor, DirectPattern, FactorPattern, Multigrid, Preconditioner, SystemMatrix, factor_is_split, pcg, pcg_deflated};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -200,8 +200,17 @@ impl Integrator {
             watch.solve();
         }
         let cached = self.preconditioner.as_mut().expect("built above");
+        // Deflation where the factor is split: its parts drop the couplings between them,
+        // and the slow modes that cross them are what the recycled directions hold. On one
+        // part (meshes under `PART_VERTICES`) the 2 cm circle skirt took a fifth fewer CG
+        // iterations but no less time, the products and passes costing what they saved;
+        // split, the 10k circle skirt took a quarter fewer and a tenth less time
+        // (docs/performance-log.md, "2026-12-05").
+        let keep = if factor_is_split(n) { self.newton.recycled_directions } else { 0 };
+        let recycled = &mut self.recycled;
+        let deflation = (keep > 0).then_some(&*recycled);
         let exact = exact_first.then(|| {
-            let cg = pcg(system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
+            let cg = pcg_deflated(system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations, deflation);
             report.cg_iterations += cg.iterations;
             watch.solve();
             cg
@@ -218,14 +227,16 @@ impl Integrator {
                     watch.forces();
                 }
                 let system = SystemMatrix { stiffness: bounded, ..*system };
-                let cg = pcg(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
+                let cg = pcg_deflated(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations, deflation.is_some().then_some(&*recycled));
                 report.cg_iterations += cg.iterations;
                 watch.solve();
                 cached.record(&cg);
+                recycled.remember(direction, keep);
                 return true;
             }
         };
         cached.record(&cg);
+        recycled.remember(direction, keep);
         false
     }
 

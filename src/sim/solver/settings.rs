@@ -68,6 +68,15 @@ pub struct NewtonSettings {
     /// The quasi-Newton step's iterations before Newton finishes the solve from where it
     /// got to (Newton then has `max_iterations` of its own).
     pub quasi_newton_iterations: usize,
+    /// How many of the last Newton directions deflate the incomplete factor's CG solves
+    /// where that factor is split into parts (`PART_VERTICES` vertices and more;
+    /// `linalg::pcg_deflated`): each solve starts from the best combination of them and
+    /// keeps its search directions A-orthogonal to them, so that the slow motion a cloth
+    /// repeats from step to step, which the split factor resolves worst, is solved for
+    /// once. Each costs a matrix product per solve (all read in one pass) and two short
+    /// passes per CG iteration. 0: off (the exact path); the fast path's garments take
+    /// `solver.fast.recycled_directions`.
+    pub recycled_directions: usize,
 }
 
 /// How an implicit step minimises its incremental potential.
@@ -158,7 +167,7 @@ impl PreconditionerChoice {
 
 impl Default for NewtonSettings {
     fn default() -> Self {
-        Self { max_iterations: DEFAULT_MAX_ITERATIONS, tolerance: 1e-5, error_share: 0.0, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true, warm_start: false, preconditioner: PreconditionerChoice::Auto, indefinite: Indefinite::Shift, retry_exact: true, minimizer: Minimizer::Newton, quasi_newton_history: 8, quasi_newton_iterations: 400 }
+        Self { max_iterations: DEFAULT_MAX_ITERATIONS, tolerance: 1e-5, error_share: 0.0, cg_tolerance: 1e-3, cg_max_iterations: 3000, forcing: true, warm_start: false, preconditioner: PreconditionerChoice::Auto, indefinite: Indefinite::Shift, retry_exact: true, minimizer: Minimizer::Newton, quasi_newton_history: 8, quasi_newton_iterations: 400, recycled_directions: 0 }
     }
 }
 
