@@ -227,7 +227,7 @@ impl Integrator {
                     watch.forces();
                 }
                 let system = SystemMatrix { stiffness: bounded, ..*system };
-                let cg = pcg_deflated(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations, deflation.is_some().then_some(&*recycled));
+                let cg = pcg_deflated(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations, deflation);
                 report.cg_iterations += cg.iterations;
                 watch.solve();
                 cached.record(&cg);
