@@ -43,11 +43,18 @@ pub struct Recycled {
 
 impl Recycled {
     /// Keeps `x` (scaled to unit length) as the newest of at most `keep` columns; columns
-    /// of another length (a mesh that changed) are forgotten.
+    /// of another length (a mesh that changed) are forgotten, and all of them with `keep`
+    /// 0.
     pub fn remember(&mut self, x: &[DVec3], keep: usize) {
+        // Off (every solve of a scene that does not deflate): nothing to keep, and no pass
+        // over `x`.
+        if keep == 0 {
+            self.columns.clear();
+            return;
+        }
         self.columns.retain(|c| c.len() == x.len());
         let norm = dot(x, x).sqrt();
-        if keep == 0 || !(norm > 0.0 && norm.is_finite()) {
+        if !(norm > 0.0 && norm.is_finite()) {
             return;
         }
         // The oldest go (their storage reused for the newest).

@@ -47,13 +47,15 @@ fn pattern(n: usize, pairs: impl Iterator<Item = (u32, u32)>) -> (Vec<u32>, Vec<
 /// rows over threads costs more in scheduling than it saves.
 pub(super) const PARALLEL_ROWS: usize = 4096;
 
-/// Calls `f(row, &mut y[row])` for every row, in chunks over rayon's pool when `y` is long.
-/// The chunks are small enough that the threads share the rows evenly: in chunks of 1 024
-/// the 5 247 rows of a 10k garment went 3 072 to one thread and 2 175 to the other. Each
-/// row is computed alone, so the result does not depend on the chunks.
+/// Rows per chunk of a parallel pass over rows: small enough that the threads share the rows
+/// evenly (in chunks of 1 024 the 5 247 rows of a 10k garment went 3 072 to one thread and
+/// 2 175 to the other).
+const CHUNK: usize = 256;
+
+/// Calls `f(row, &mut y[row])` for every row, in chunks of [`CHUNK`] rows over rayon's pool
+/// when `y` is long. Each row is computed alone, so the result does not depend on the chunks.
 pub(super) fn for_rows(y: &mut [DVec3], f: impl Fn(usize, &mut DVec3) + Sync) {
     use rayon::prelude::*;
-    const CHUNK: usize = 256;
     if y.len() < PARALLEL_ROWS {
         y.iter_mut().enumerate().for_each(|(row, out)| f(row, out));
     } else {
@@ -69,7 +71,6 @@ pub(super) fn for_rows(y: &mut [DVec3], f: impl Fn(usize, &mut DVec3) + Sync) {
 /// the `j`-th): calls `f(row, &mut y[row * k..row * k + k])` for every row.
 pub(super) fn for_row_groups(y: &mut [DVec3], k: usize, f: impl Fn(usize, &mut [DVec3]) + Sync) {
     use rayon::prelude::*;
-    const CHUNK: usize = 256;
     if y.len() < PARALLEL_ROWS * k {
         y.chunks_mut(k).enumerate().for_each(|(row, out)| f(row, out));
     } else {
