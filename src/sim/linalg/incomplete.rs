@@ -3,6 +3,7 @@
 use super::storage::merge_rows;
 use super::system::SystemMatrix;
 use glam::{DMat3, DVec3, Mat3};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Block incomplete LDLᵀ factor of the system matrix, A ≈ (D + U) D⁻¹ (D + U)ᵀ with U
 /// strictly lower and D block diagonal, both in 3×3 blocks, on one of two patterns
@@ -19,6 +20,8 @@ use glam::{DMat3, DVec3, Mat3};
 pub struct IncompleteCholesky {
     parts: Vec<FactorPart>,
     pub pattern: FactorPattern,
+    /// The diagonal shift it was made with, a share of the diagonal (0: none needed).
+    pub shift: f64,
     /// Multiply-adds of one conjugate-gradient iteration with it: the matrix product and
     /// the two triangular solves.
     pub iteration_cost: f64,
@@ -119,10 +122,12 @@ impl IncompleteCholesky {
                 same
             });
         }
+        // Set by the first part to break down, so that the others stop too.
+        let broken = AtomicBool::new(false);
         let parts = if count == 1 {
-            vec![FactorPart::new(a, &coupled, shift, pattern, 0, n)?]
+            vec![FactorPart::new(a, &coupled, shift, pattern, 0, n, &broken)?]
         } else {
-            bounds.par_iter().map(|&(lo, hi)| FactorPart::new(a, &coupled, shift, pattern, lo, hi)).collect::<Option<Vec<_>>>()?
+            bounds.par_iter().map(|&(lo, hi)| FactorPart::new(a, &coupled, shift, pattern, lo, hi, &broken)).collect::<Option<Vec<_>>>()?
         };
         // A block product is 27 multiply-adds; a CG iteration applies every factor block
         // twice and the matrix once (9 per block, 3 per bending entry).
@@ -130,7 +135,7 @@ impl IncompleteCholesky {
         let factor_blocks: usize = parts.iter().map(|p| p.lower.len() + p.pivot_inverse.len()).sum();
         let per_iteration = 18 * factor_blocks + 9 * a.stiffness.values.len() + 3 * a.bending.map_or(0, |q| q.values.len());
         let cost_in_iterations = 27.0 * products as f64 / per_iteration.max(1) as f64;
-        Some(Self { parts, pattern, iteration_cost: per_iteration as f64, cost_in_iterations })
+        Some(Self { parts, pattern, shift, iteration_cost: per_iteration as f64, cost_in_iterations })
     }
 
     /// z = P⁻¹ r, each part on its own.
@@ -156,8 +161,9 @@ impl IncompleteCholesky {
 
 impl FactorPart {
     /// Factors rows and columns `lo..hi` of A + shift·diag(A) on `pattern`, with the
-    /// contact couplings' lower blocks `coupled` by row.
-    fn new(a: &SystemMatrix, coupled: &[Vec<(u32, DMat3)>], shift: f64, pattern: FactorPattern, lo: usize, hi: usize) -> Option<Self> {
+    /// contact couplings' lower blocks `coupled` by row; None if a pivot breaks down here,
+    /// setting `broken`, or once another part has set it.
+    fn new(a: &SystemMatrix, coupled: &[Vec<(u32, DMat3)>], shift: f64, pattern: FactorPattern, lo: usize, hi: usize, broken: &AtomicBool) -> Option<Self> {
         let k = a.stiffness;
         let rows = hi - lo;
         let mut row_start = Vec::with_capacity(rows + 1);
@@ -172,6 +178,9 @@ impl FactorPart {
         let mut block_products = 0;
         row_start.push(0);
         for (row, coupled_row) in (lo..hi).zip(&coupled[lo..hi]) {
+            if row % 64 == 0 && broken.load(Ordering::Relaxed) {
+                return None;
+            }
             let start = cols.len();
             if !a.fixed[row] {
                 let q_row = a.bending.map_or((&[][..], 0), |q| q.row_pattern(row));
@@ -240,6 +249,7 @@ impl FactorPart {
                 // longer symmetric and the conjugate gradient stalls.
                 let pivot = 0.5 * (pivot + pivot.transpose());
                 if !positive_definite(&pivot) {
+                    broken.store(true, Ordering::Relaxed);
                     return None;
                 }
                 let inverse = pivot.inverse();

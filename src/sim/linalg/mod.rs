@@ -21,7 +21,7 @@ pub use cg::{CgReport, Recycled, pcg, pcg_deflated};
 pub use direct::{DirectFactor, DirectPattern};
 pub use incomplete::{FactorPattern, IncompleteCholesky, factor_is_split};
 pub use multigrid::Multigrid;
-pub use preconditioner::Preconditioner;
+pub use preconditioner::{Preconditioner, ShiftMemory};
 pub use scalar_factor::{ScalarFactor, ScalarPattern};
 pub use storage::{BlockCsr, ScalarCsr};
 pub use system::{Coupling, SystemMatrix};

@@ -82,6 +82,40 @@ fn incomplete_factor_takes_the_contact_couplings_in() {
 }
 
 #[test]
+fn incomplete_factors_start_from_the_shift_the_last_one_needed() {
+    // Two vertices of unit mass joined by a coupling c·I: A = [[1, c], [c, 1]] ⊗ I₃. The
+    // factor on the whole pattern is exact, so it breaks down unless 1 + s > |c| for the
+    // diagonal shift s: at c = 1.005 only the shifts from 1e-2 up succeed, at c = 0.5 all.
+    let matrix = |c: f64| {
+        let mut k = BlockCsr::with_pattern(2, std::iter::once((0, 1)));
+        for (row, col) in [(0, 1), (1, 0)] {
+            let slot = k.slot(row, col);
+            k.values[slot] = DMat3::IDENTITY * c;
+        }
+        k
+    };
+    let (hard, easy) = (matrix(1.005), matrix(0.5));
+    let (mass, fixed) = ([1.0; 2], [false; 2]);
+    let system = |k| SystemMatrix { mass_diagonal: &mass, stiffness: k, bending: None, fixed: &fixed, couplings: &[] };
+    let shift = |p: Preconditioner| match p {
+        Preconditioner::IncompleteCholesky(factor) => factor.shift,
+        _ => panic!("the factorisation broke down at every shift"),
+    };
+    assert_eq!(shift(system(&easy).preconditioner(FactorPattern::Wide)), 0.0);
+    let mut memory = ShiftMemory::default();
+    assert_eq!(shift(system(&hard).preconditioner_remembering(FactorPattern::Wide, &mut memory)), 1e-2);
+    // The next factors start where the last one ended, though the matrix needs none now...
+    for _ in 0..2 {
+        assert_eq!(shift(system(&easy).preconditioner_remembering(FactorPattern::Wide, &mut memory)), 1e-2);
+    }
+    // ...and every fourth tries the next smaller shift, so the start comes back down.
+    assert_eq!(shift(system(&easy).preconditioner_remembering(FactorPattern::Wide, &mut memory)), 1e-3);
+    // Each pattern remembers its own.
+    assert_eq!(shift(system(&easy).preconditioner_remembering(FactorPattern::Ring, &mut memory)), 0.0);
+    assert_eq!(shift(system(&easy).preconditioner_remembering(FactorPattern::Wide, &mut memory)), 1e-3);
+}
+
+#[test]
 fn block_factor_of_a_banded_matrix_is_exact_and_parts_still_converge() {
     for n in [50, 1000, PART_VERTICES + 1000, 3 * PART_VERTICES] {
         let (k, q, mass) = banded_chain(n);

@@ -127,6 +127,8 @@ pub struct Integrator {
     preconditioner: Option<CachedPreconditioner>,
     /// The pattern of the incomplete factors, chosen by what each has cost so far.
     incomplete_pattern: PatternChoice,
+    /// Where the incomplete factors' diagonal shifts start.
+    incomplete_shift: crate::sim::linalg::ShiftMemory,
     /// Earlier Newton directions the incomplete factor's solves start from.
     recycled: crate::sim::linalg::Recycled,
     /// Ordering and symbolic factor for complete Cholesky factors, made once per model.
@@ -161,6 +163,7 @@ impl Integrator {
             forces: Vec::new(),
             preconditioner: None,
             incomplete_pattern: PatternChoice::default(),
+            incomplete_shift: Default::default(),
             recycled: Default::default(),
             direct_pattern: None,
             contact_stats: ContactStats::default(),

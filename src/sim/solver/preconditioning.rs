@@ -185,14 +185,14 @@ impl Integrator {
             }
             let pattern = self.incomplete_pattern.next();
             let bounded_system = SystemMatrix { stiffness: bounded, ..*system };
-            let mut preconditioner = bounded_system.preconditioner(pattern);
+            let mut preconditioner = bounded_system.preconditioner_remembering(pattern, &mut self.incomplete_shift);
             report.factorizations += 1;
             if !matches!(preconditioner, Preconditioner::IncompleteCholesky(_)) {
                 self.incomplete_pattern.broke_down(pattern);
                 // Block Jacobi would serve a whole solve, hundreds of CG iterations on a
                 // drape; the wide pattern breaks down far more rarely.
                 if pattern == FactorPattern::Ring {
-                    preconditioner = bounded_system.preconditioner(FactorPattern::Wide);
+                    preconditioner = bounded_system.preconditioner_remembering(FactorPattern::Wide, &mut self.incomplete_shift);
                     report.factorizations += 1;
                 }
             }
