@@ -4,7 +4,7 @@
 //! one place that names them all, so the factors never import each other.
 
 use super::direct::DirectFactor;
-use super::incomplete::{FactorPattern, IncompleteCholesky};
+use super::incomplete::{FactorPattern, IncompleteCholesky, factor_is_split};
 use super::multigrid::Multigrid;
 use super::system::SystemMatrix;
 use glam::{DMat3, DVec3};
@@ -48,10 +48,27 @@ impl Preconditioner {
 /// turn until one does not break down.
 const SHIFTS: [f64; 4] = [0.0, 1e-3, 1e-2, 1e-1];
 
+/// The shifts of a one-ring factor of a split-size matrix (`factor_is_split`): those of
+/// [`SHIFTS`], then up to the diagonal itself. On the 10k circle skirt's bounded matrices the
+/// one-ring factor broke down at every shift of [`SHIFTS`], so every factor was the whole
+/// pattern's, whose blocks (with the matrix's) no longer fit in the cache: a CG iteration read
+/// about 13 MB. Made at a shift of the whole diagonal, the one-ring factor reads an eighth
+/// of the blocks, and the pattern choice (`solver::preconditioning::PatternChoice`) took it
+/// for most factors: a fifth fewer Newton iterations, a third fewer factors and about 40 %
+/// less solve time per CG iteration (docs/performance-log.md, "2026-12-05, third sitting").
+/// On smaller meshes, whose factors stay in the cache, it was taken too and cost more CG
+/// iterations than it saved (the 2 cm circle skirt's exact path: 84 335 against 49 481).
+const RING_SPLIT_SHIFTS: [f64; 6] = [0.0, 1e-3, 1e-2, 1e-1, 0.3, 1.0];
+
+/// The shifts a factor on `pattern` of a matrix over `n` vertices tries.
+fn shifts(pattern: FactorPattern, n: usize) -> &'static [f64] {
+    if pattern == FactorPattern::Ring && factor_is_split(n) { &RING_SPLIT_SHIFTS } else { &SHIFTS }
+}
+
 /// Factors between trials of the shift below the one the last factor of a pattern needed.
 const SHIFT_PROBE: usize = 4;
 
-/// Where a run's next incomplete factor of each pattern starts on [`SHIFTS`]: at the shift
+/// Where a run's next incomplete factor of each pattern starts on its shifts ([`shifts`]): at the shift
 /// the last one needed, and one lower every [`SHIFT_PROBE`] factors. A matrix that breaks
 /// the unshifted factorisation usually breaks it again at the next Newton iteration: on the
 /// 10k circle skirt two of every three factorisations started from no shift failed
@@ -60,7 +77,7 @@ const SHIFT_PROBE: usize = 4;
 /// same path on every machine.
 #[derive(Debug, Clone, Default)]
 pub struct ShiftMemory {
-    /// Index into [`SHIFTS`] and factors made, by pattern (`Wide`, `Ring`).
+    /// Index into the pattern's shifts ([`shifts`]) and factors made, by pattern (`Wide`, `Ring`).
     start: [usize; 2],
     made: [usize; 2],
 }
@@ -76,14 +93,16 @@ impl SystemMatrix<'_> {
     pub fn preconditioner_remembering(&self, pattern: FactorPattern, memory: &mut ShiftMemory) -> Preconditioner {
         let p = usize::from(pattern == FactorPattern::Ring);
         memory.made[p] += 1;
-        let first = if memory.made[p].is_multiple_of(SHIFT_PROBE) { memory.start[p].saturating_sub(1) } else { memory.start[p] };
-        for (level, &shift) in SHIFTS.iter().enumerate().skip(first) {
+        let shifts = shifts(pattern, self.fixed.len());
+        let start = memory.start[p].min(shifts.len() - 1);
+        let first = if memory.made[p].is_multiple_of(SHIFT_PROBE) { start.saturating_sub(1) } else { start };
+        for (level, &shift) in shifts.iter().enumerate().skip(first) {
             if let Some(factor) = IncompleteCholesky::new(self, shift, pattern) {
                 memory.start[p] = level;
                 return Preconditioner::IncompleteCholesky(factor);
             }
         }
-        memory.start[p] = SHIFTS.len() - 1;
+        memory.start[p] = shifts.len() - 1;
         Preconditioner::BlockJacobi(self.block_jacobi())
     }
 }

@@ -116,6 +116,41 @@ fn incomplete_factors_start_from_the_shift_the_last_one_needed() {
 }
 
 #[test]
+fn one_ring_factors_of_split_size_matrices_take_larger_shifts() {
+    // Vertices in pairs (2i, 2i + 1) of unit mass joined by c·I: each pair's block is
+    // [[1, c], [c, 1]] ⊗ I₃, whose factor breaks down unless 1 + s > c for the shift s. At
+    // c = 1.2 every shift up to 1e-1 fails; a one-ring factor of a matrix large enough to be
+    // split goes on to 0.3, one of a smaller matrix or on the whole pattern does not.
+    let paired = |n: usize| {
+        let mut k = BlockCsr::with_pattern(n, (0..n as u32 / 2).map(|i| (2 * i, 2 * i + 1)));
+        for i in 0..n as u32 / 2 {
+            for (row, col) in [(2 * i, 2 * i + 1), (2 * i + 1, 2 * i)] {
+                let slot = k.slot(row, col);
+                k.values[slot] = DMat3::IDENTITY * 1.2;
+            }
+        }
+        k
+    };
+    for (n, split) in [(2 * PART_VERTICES, true), (PART_VERTICES / 2, false)] {
+        assert_eq!(factor_is_split(n), split);
+        let k = paired(n);
+        let (mass, fixed) = (vec![1.0; n], vec![false; n]);
+        let system = SystemMatrix { mass_diagonal: &mass, stiffness: &k, bending: None, fixed: &fixed, couplings: &[] };
+        let mut memory = ShiftMemory::default();
+        match system.preconditioner_remembering(FactorPattern::Ring, &mut memory) {
+            Preconditioner::IncompleteCholesky(factor) => assert!(split && factor.shift == 0.3, "n = {n}: shift {}", factor.shift),
+            _ => assert!(!split, "n = {n}: no one-ring factor at any shift"),
+        }
+        assert!(matches!(system.preconditioner_remembering(FactorPattern::Wide, &mut memory), Preconditioner::BlockJacobi(_)), "n = {n}");
+        // The next one-ring factor starts from the shift the last one needed.
+        if split {
+            let Preconditioner::IncompleteCholesky(factor) = system.preconditioner_remembering(FactorPattern::Ring, &mut memory) else { panic!("no factor") };
+            assert_eq!(factor.shift, 0.3);
+        }
+    }
+}
+
+#[test]
 fn block_factor_of_a_banded_matrix_is_exact_and_parts_still_converge() {
     for n in [50, 1000, PART_VERTICES + 1000, 3 * PART_VERTICES] {
         let (k, q, mass) = banded_chain(n);
