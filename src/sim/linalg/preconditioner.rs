@@ -54,8 +54,8 @@ const SHIFTS: [f64; 4] = [0.0, 1e-3, 1e-2, 1e-1];
 /// pattern's, whose blocks (with the matrix's) no longer fit in the cache: a CG iteration read
 /// about 13 MB. Made at a shift of the whole diagonal, the one-ring factor reads an eighth
 /// of the blocks, and the pattern choice (`solver::preconditioning::PatternChoice`) took it
-/// for most factors: a fifth fewer Newton iterations, a third fewer factors and about 40 %
-/// less solve time per CG iteration (docs/performance-log.md, "2026-12-05, third sitting").
+/// for most factors: a fifth fewer Newton iterations, a third fewer factors and a third less
+/// solve time per CG iteration (docs/performance-log.md, "2026-12-05, third sitting").
 /// On smaller meshes, whose factors stay in the cache, it was taken too and cost more CG
 /// iterations than it saved (the 2 cm circle skirt's exact path: 84 335 against 49 481).
 const RING_SPLIT_SHIFTS: [f64; 6] = [0.0, 1e-3, 1e-2, 1e-1, 0.3, 1.0];
@@ -68,8 +68,9 @@ fn shifts(pattern: FactorPattern, n: usize) -> &'static [f64] {
 /// Factors between trials of the shift below the one the last factor of a pattern needed.
 const SHIFT_PROBE: usize = 4;
 
-/// Where a run's next incomplete factor of each pattern starts on its shifts ([`shifts`]): at the shift
-/// the last one needed, and one lower every [`SHIFT_PROBE`] factors. A matrix that breaks
+/// Where a run's next incomplete factor of each pattern starts on its shifts ([`shifts`]):
+/// at the shift the last one needed, and one lower every [`SHIFT_PROBE`] factors (clamped
+/// to the pattern's list, which depends on the matrix's size). A matrix that breaks
 /// the unshifted factorisation usually breaks it again at the next Newton iteration: on the
 /// 10k circle skirt two of every three factorisations started from no shift failed
 /// (each costing nearly a whole factorisation, the parts running side by side), and the
