@@ -81,20 +81,25 @@ fn incomplete_factor_takes_the_contact_couplings_in() {
     assert!(report.iterations <= 3, "{} iterations", report.iterations);
 }
 
-#[test]
-fn incomplete_factors_start_from_the_shift_the_last_one_needed() {
-    // Two vertices of unit mass joined by a coupling c·I: A = [[1, c], [c, 1]] ⊗ I₃. The
-    // factor on the whole pattern is exact, so it breaks down unless 1 + s > |c| for the
-    // diagonal shift s: at c = 1.005 only the shifts from 1e-2 up succeed, at c = 0.5 all.
-    let matrix = |c: f64| {
-        let mut k = BlockCsr::with_pattern(2, std::iter::once((0, 1)));
-        for (row, col) in [(0, 1), (1, 0)] {
+/// The stiffness of `n` vertices in pairs (2i, 2i + 1), each pair joined by c·I: with unit
+/// masses each pair's block is [[1, c], [c, 1]] ⊗ I₃, whose factor (exact on either pattern)
+/// breaks down unless 1 + s > |c| for the diagonal shift s.
+fn paired_vertices(n: usize, c: f64) -> BlockCsr {
+    let mut k = BlockCsr::with_pattern(n, (0..n as u32 / 2).map(|i| (2 * i, 2 * i + 1)));
+    for i in 0..n as u32 / 2 {
+        for (row, col) in [(2 * i, 2 * i + 1), (2 * i + 1, 2 * i)] {
             let slot = k.slot(row, col);
             k.values[slot] = DMat3::IDENTITY * c;
         }
-        k
-    };
-    let (hard, easy) = (matrix(1.005), matrix(0.5));
+    }
+    k
+}
+
+#[test]
+fn incomplete_factors_start_from_the_shift_the_last_one_needed() {
+    // Two vertices of unit mass joined by c·I (`paired_vertices`): at c = 1.005 only the
+    // shifts from 1e-2 up succeed, at c = 0.5 all.
+    let (hard, easy) = (paired_vertices(2, 1.005), paired_vertices(2, 0.5));
     let (mass, fixed) = ([1.0; 2], [false; 2]);
     let system = |k| SystemMatrix { mass_diagonal: &mass, stiffness: k, bending: None, fixed: &fixed, couplings: &[] };
     let shift = |p: Preconditioner| match p {
@@ -117,23 +122,12 @@ fn incomplete_factors_start_from_the_shift_the_last_one_needed() {
 
 #[test]
 fn one_ring_factors_of_split_size_matrices_take_larger_shifts() {
-    // Vertices in pairs (2i, 2i + 1) of unit mass joined by c·I: each pair's block is
-    // [[1, c], [c, 1]] ⊗ I₃, whose factor breaks down unless 1 + s > c for the shift s. At
-    // c = 1.2 every shift up to 1e-1 fails; a one-ring factor of a matrix large enough to be
-    // split goes on to 0.3, one of a smaller matrix or on the whole pattern does not.
-    let paired = |n: usize| {
-        let mut k = BlockCsr::with_pattern(n, (0..n as u32 / 2).map(|i| (2 * i, 2 * i + 1)));
-        for i in 0..n as u32 / 2 {
-            for (row, col) in [(2 * i, 2 * i + 1), (2 * i + 1, 2 * i)] {
-                let slot = k.slot(row, col);
-                k.values[slot] = DMat3::IDENTITY * 1.2;
-            }
-        }
-        k
-    };
+    // Vertices of unit mass in pairs joined by 1.2·I (`paired_vertices`): every shift up to
+    // 1e-1 fails; a one-ring factor of a matrix large enough to be split goes on to 0.3, one
+    // of a smaller matrix or on the whole pattern does not.
     for (n, split) in [(2 * PART_VERTICES, true), (PART_VERTICES / 2, false)] {
         assert_eq!(factor_is_split(n), split);
-        let k = paired(n);
+        let k = paired_vertices(n, 1.2);
         let (mass, fixed) = (vec![1.0; n], vec![false; n]);
         let system = SystemMatrix { mass_diagonal: &mass, stiffness: &k, bending: None, fixed: &fixed, couplings: &[] };
         let mut memory = ShiftMemory::default();
