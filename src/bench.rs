@@ -97,6 +97,12 @@ fn cases(quick: bool) -> Vec<Case> {
             out.push(Case { threads, ..case(&format!("{name}, {}", path.name()), preset, o, duration, None) });
         }
     };
+    // A run on the fast path only, on two threads (where the exact path's whole run would
+    // take too long to bench).
+    let fast = |out: &mut Vec<Case>, name: &str, preset, mut overrides: Vec<String>| {
+        overrides.push(SolverPath::Fast.setting());
+        out.push(Case { threads: Some(&[2]), ..case(name, preset, overrides, None, None) });
+    };
     let edge = |e: f64| vec![format!("mesh.edge_length={e:.5}")];
     if quick {
         both(&mut out, "cusick-drape, to settling", "cusick-drape", vec![], None, None);
@@ -108,10 +114,7 @@ fn cases(quick: bool) -> Vec<Case> {
         // The fast path's growth with the mesh, whole runs (the exact path's growth is the
         // two-step rows below: its whole runs at 80 000 triangles take hours).
         for n in [5000.0, 80000.0] {
-            let name = format!("cusick-drape ~{} tri, to settling, fast", n as u64);
-            let mut o = edge(drape_edge_for(n));
-            o.push(SolverPath::Fast.setting());
-            out.push(Case { threads: Some(&[2]), ..case(&name, "cusick-drape", o, None, None) });
+            fast(&mut out, &format!("cusick-drape ~{} tri, to settling, fast", n as u64), "cusick-drape", edge(drape_edge_for(n)));
         }
         // Cloth dropped onto props: the tablecloth to settling, and the peers' drop of a
         // 1 m² cloth onto a sphere over its first 0.4 s (the fall and the wrap), on one thread.
@@ -124,9 +127,7 @@ fn cases(quick: bool) -> Vec<Case> {
         // The same garments at about 10k triangles (9 956, 9 956, 10 226 and 9 789), on the
         // fast path only: the exact path takes 4–7 minutes each there (docs/garments.md).
         for (garment, e) in [("skirt-gored-straight", 0.0108), ("skirt-gored-bias", 0.0108), ("skirt-circle", 0.0141), ("shift-dress", 0.013)] {
-            let mut o = edge(e);
-            o.push(SolverPath::Fast.setting());
-            out.push(Case { threads: Some(&[2]), ..case(&format!("{garment} ~10k tri, to settling, fast"), garment, o, None, None) });
+            fast(&mut out, &format!("{garment} ~10k tri, to settling, fast"), garment, edge(e));
         }
         // The same drop on the fast path with the quasi-Newton minimizer
         // (`solver.newton.minimizer`), the step design docs/fast-path.md measured against Newton.
