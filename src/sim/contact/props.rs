@@ -77,10 +77,13 @@ pub struct SurfacePoint {
     pub normal: DVec3,
 }
 
-/// How far from a prop's surface a ray cast's hit may lie and still be a hit, m: the
-/// casts run in single precision, whose genuine hits on props within a few metres of the
-/// origin lie within micrometres of the surface; the false ones seen were millimetres off.
-const RAY_HIT_TOLERANCE: f64 = 1e-5;
+/// How far from a prop's surface a ray cast's hit may lie and still be a hit: 10 µm, plus
+/// a millionth of the hit's distance from the origin (about eight units in the last place
+/// of the single precision the casts run in, so that props tens of metres out keep their
+/// genuine hits). The false hits seen were millimetres off.
+fn ray_hit_tolerance(point: DVec3) -> f64 {
+    1e-5 + 1e-6 * point.length()
+}
 
 impl Prop {
     pub fn new(name: &str, shape: PropShape, position: DVec3, rotation: DQuat) -> Result<Self, PropError> {
@@ -216,7 +219,7 @@ impl Prop {
     /// it: a 1.6 mm segment 2.15 mm from the pedestal's rim, above its top, was reported
     /// as entering it, and the 80 000-triangle Cusick drape was refused as starting
     /// through its pedestal. A hit is kept only where its point lies on the surface (within
-    /// [`RAY_HIT_TOLERANCE`]); past one that does not, the cast goes on from there.
+    /// [`ray_hit_tolerance`]); past one that does not, the cast goes on from there.
     pub fn segment_entry(&self, a: DVec3, b: DVec3) -> Option<SurfacePoint> {
         let d = b - a;
         let length = d.length();
@@ -233,11 +236,12 @@ impl Prop {
             let ray = Ray::new(to_f32(origin), to_f32(direction));
             let hit = self.collider.cast_ray_and_get_normal(&self.pose, &ray, (length - travelled) as f32, false)?;
             let point = origin + direction * hit.time_of_impact as f64;
-            if self.surface_point(point).distance.abs() <= RAY_HIT_TOLERANCE {
+            let tolerance = ray_hit_tolerance(point);
+            if self.surface_point(point).distance.abs() <= tolerance {
                 let normal = to_f64(hit.normal).normalize();
                 return Some(SurfacePoint { distance: 0.0, point, normal: if normal.dot(d) < 0.0 { normal } else { -normal } });
             }
-            travelled += hit.time_of_impact as f64 + RAY_HIT_TOLERANCE;
+            travelled += hit.time_of_impact as f64 + tolerance;
             if travelled >= length {
                 return None;
             }
