@@ -218,8 +218,8 @@ impl Prop {
     /// parry3d's ray cast against a cylinder can report a hit for a ray that only grazes
     /// it: a 1.6 mm segment 2.15 mm from the pedestal's rim, above its top, was reported
     /// as entering it, and the 80 000-triangle Cusick drape was refused as starting
-    /// through its pedestal. A hit is kept only where its point lies on the surface (within
-    /// [`ray_hit_tolerance`]); past one that does not, the cast goes on from there.
+    /// through its pedestal. A hit is kept unless its point lies outside the prop (by more
+    /// than [`ray_hit_tolerance`]); past one that does, the cast goes on from there.
     pub fn segment_entry(&self, a: DVec3, b: DVec3) -> Option<SurfacePoint> {
         let d = b - a;
         let length = d.length();
@@ -237,7 +237,8 @@ impl Prop {
             let hit = self.collider.cast_ray_and_get_normal(&self.pose, &ray, (length - travelled) as f32, false)?;
             let point = origin + direction * hit.time_of_impact as f64;
             let tolerance = ray_hit_tolerance(point);
-            if self.surface_point(point).distance.abs() <= tolerance {
+            // A hit inside the prop is an entry whose point is imprecise: the segment got in.
+            if self.surface_point(point).distance <= tolerance {
                 let normal = to_f64(hit.normal).normalize();
                 return Some(SurfacePoint { distance: 0.0, point, normal: if normal.dot(d) < 0.0 { normal } else { -normal } });
             }
