@@ -101,6 +101,15 @@ pub struct PanelConfig {
     pub placement: PlacementConfig,
 }
 
+impl PanelConfig {
+    /// The diagonal of the bounding box of the outline's corners, in the garment's units.
+    pub fn extent(&self) -> f64 {
+        let corners = std::iter::once(self.start).chain(self.edges.iter().map(|e| e.to)).map(DVec2::from_array);
+        let (lo, hi) = corners.fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        if lo.x <= hi.x { lo.distance(hi) } else { 0.0 }
+    }
+}
+
 /// A sampled curve: points from start to end with their arc lengths.
 #[derive(Debug, Clone)]
 pub struct Polyline {

@@ -59,7 +59,9 @@ pub const MIN_PICTURE_PIXELS: f64 = 8.0;
 /// `fov_y` (radians).
 pub fn check_camera(config: &SceneConfig, distance: f64, height: u32, fov_y: f64) -> Result<(), String> {
     let c = &config.cloth;
-    let size = c.diameter.max(c.length).max(c.width);
+    // A garment's cloth is its pattern: its largest panel stands for its extent.
+    let garment = config.garment.as_ref().map_or(0.0, |g| g.panels.iter().map(|p| p.extent()).fold(0.0, f64::max) * g.units.metres());
+    let size = c.diameter.max(c.length).max(c.width).max(garment);
     let pixels = size / (2.0 * distance * (0.5 * fov_y).tan()) * f64::from(height);
     if pixels < MIN_PICTURE_PIXELS {
         let farthest = size * f64::from(height) / (2.0 * (0.5 * fov_y).tan() * MIN_PICTURE_PIXELS);
@@ -125,5 +127,22 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
             short(target.1),
             short(duration)
         ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A garment's cloth is its pattern: a camera 1.2 m from a skirt frames it (the
+    /// largest gore, about 0.6 m, spans hundreds of pixels), one 1 km away does not.
+    /// Before the pattern counted, every distance was refused for every garment.
+    #[test]
+    fn a_garment_is_framed_by_its_pattern() {
+        let (config, _) = crate::scene::load_scene("skirt-gored-bias", &[]).unwrap();
+        let fov = 40f64.to_radians();
+        check_camera(&config, 1.2, 800, fov).unwrap();
+        let refused = check_camera(&config, 1000.0, 800, fov).unwrap_err();
+        assert!(refused.contains("would span"), "{refused}");
     }
 }
