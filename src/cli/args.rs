@@ -131,6 +131,11 @@ pub enum Command {
         #[command(subcommand)]
         action: FabricAction,
     },
+    /// Sewing patterns from other tools (GarmentCode's JSON specification) as garment scenes.
+    Pattern {
+        #[command(subcommand)]
+        action: PatternAction,
+    },
     /// Time the paper's Table 1 scenes and the Cusick drape at about 800, 5 000, 20 000
     /// and 80 000 triangles, on 1 and 2 threads; writes bench.csv and bench.json.
     Bench {
@@ -240,3 +245,30 @@ pub struct ScreenshotArgs {
 
 /// A day: longer than any bundled scene takes, short enough that a runaway run ends.
 pub const DEFAULT_MAX_WALL: f64 = 86_400.0;
+
+#[derive(Subcommand)]
+pub enum PatternAction {
+    /// Convert a GarmentCode pattern specification (JSON: panels, their 3D placement,
+    /// stitches) into a garment scene file to run, view and edit (docs/garments.md).
+    Import {
+        /// The specification file (GarmentCode's `*_specification.json`).
+        spec: std::path::PathBuf,
+        /// Write the scene file here (default: standard output).
+        #[arg(long, value_name = "FILE.toml")]
+        out: Option<std::path::PathBuf>,
+        /// The form's bundled size (uk-10, uk-12, uk-14).
+        #[arg(long, default_value = "uk-14")]
+        form: String,
+        /// The fabric (a bundled name, see `rosette fabric list`).
+        #[arg(long, default_value = "cotton-shirting")]
+        fabric: String,
+        /// The warp's angle in each panel as drafted, degrees from its x axis: 90 runs it
+        /// up and down the panel (straight grain), 45 or 135 cuts every panel on the bias.
+        #[arg(long, default_value_t = 90.0, allow_hyphen_values = true)]
+        grain_deg: f64,
+        /// Replace an existing file that is not Rosette's own output of the same kind (an
+        /// input of the command is never overwritten).
+        #[arg(long)]
+        force: bool,
+    },
+}

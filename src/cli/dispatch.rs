@@ -1,6 +1,6 @@
 //! From the parsed command line to the subcommand that carries it out.
 
-use super::args::{Cli, Command, FabricAction, ScreenshotArgs};
+use super::args::{Cli, Command, FabricAction, PatternAction, ScreenshotArgs};
 use super::run::{RunLimits, RunOutputs};
 use super::{fabric, sweeps};
 use rosette::app::viewer::ViewerOptions;
@@ -53,6 +53,9 @@ pub fn dispatch(cli: Cli) -> ExitCode {
             FabricAction::Check { fabric } => fabric::check(&fabric),
             FabricAction::Export { fabric, arcsim: _, out, force } => super::arcsim::export(&fabric, out.as_deref(), force),
         },
+        Some(Command::Pattern { action: PatternAction::Import { spec, out, form, fabric, grain_deg, force } }) => {
+            super::pattern::import(&spec, out.as_deref(), &form, &fabric, grain_deg, force)
+        }
         Some(Command::Run { preset, mut overrides, duration, metrics, outline, step_log, max_steps, max_wall, fast, plan, export, export_frames, force, screenshot }) => {
             if fast {
                 overrides.push(SolverPath::Fast.setting());

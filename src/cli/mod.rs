@@ -8,6 +8,7 @@ pub mod card;
 pub mod dispatch;
 pub mod fabric;
 pub mod outputs;
+pub mod pattern;
 pub mod run;
 pub mod sweeps;
 

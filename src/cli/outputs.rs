@@ -23,6 +23,7 @@ pub const DRAPE_REFERENCE_CSV: Kind =
 pub const BENCH_CSV: Kind = Kind { noun: "a benchmark table", signature: Signature::Starts("case,threads,") };
 pub const BENCH_JSON: Kind = Kind { noun: "a benchmark's numbers", signature: Signature::Starts("[\n  {\n    \"case\": ") };
 pub const ARCSIM_FILE: Kind = Kind { noun: "an ARCSim material", signature: Signature::Starts("// ARCSim material of ") };
+pub const PATTERN_SCENE: Kind = Kind { noun: "an imported garment scene", signature: Signature::SecondLine("# Written by `rosette pattern import") };
 pub const FABRIC_FILE: Kind = Kind { noun: "a fabric file", signature: Signature::SecondLine("# Written by `rosette fabric import") };
 
 /// The files a command read (scenes, fabrics, sheets), with the meshes its scene's props

@@ -13,6 +13,7 @@
 
 pub mod flat;
 pub mod form;
+pub mod garmentcode;
 pub mod mesh;
 pub mod pattern;
 pub mod place;

@@ -24,6 +24,8 @@ pub enum FileKind {
     Csv,
     /// An ARCSim material (JSON).
     Arcsim,
+    /// A sewing pattern in GarmentCode's specification format (JSON).
+    Pattern,
 }
 
 impl FileKind {
@@ -37,6 +39,8 @@ impl FileKind {
             FileKind::Csv => 16 << 20,
             // A material is under 2 kB; its comments may be long.
             FileKind::Arcsim => 1 << 20,
+            // GarmentCode's largest bundled specification (a jumpsuit, 12 panels) is 48 kB.
+            FileKind::Pattern => 16 << 20,
         }
     }
 
@@ -48,6 +52,7 @@ impl FileKind {
             FileKind::Obj => "mesh file (OBJ)",
             FileKind::Csv => "CSV file",
             FileKind::Arcsim => "material file in ARCSim's JSON format",
+            FileKind::Pattern => "pattern in GarmentCode's JSON format",
         }
     }
 
@@ -58,7 +63,7 @@ impl FileKind {
             FileKind::Scene | FileKind::Fabric => "toml",
             FileKind::Obj => "obj",
             FileKind::Csv => "csv",
-            FileKind::Arcsim => "json",
+            FileKind::Arcsim | FileKind::Pattern => "json",
         }
     }
 }

@@ -1,0 +1,112 @@
+//! `rosette pattern import`: a GarmentCode pattern specification as a garment scene file.
+
+use super::outputs::{self, PATTERN_SCENE};
+use super::{bad_input, lost_output};
+use rosette::garment::form::FormConfig;
+use rosette::garment::garmentcode::{ImportOptions, import as import_spec};
+use rosette::io::guard::Plan;
+use rosette::io::read::{FileKind, read_text};
+use rosette::{errln, out};
+use std::path::Path;
+use std::process::ExitCode;
+
+/// The scene around an imported pattern: the bundled garments' settings (docs/garments.md),
+/// the mesh at 2 cm.
+const SCENE: &str = r#"kind = "garment"
+duration = 6.0
+gravity_ramp = 1.5
+settle_speed = 1e-3
+settle_window = 0.3
+
+[physics]
+compression_buckling = true
+
+[mesh]
+edge_length = 0.02
+
+[solver]
+integrator = "implicit-euler"
+dt = 0.004
+damping = 4.0
+
+[solver.newton]
+max_iterations = 100
+
+[contact]
+thickness = 0.002
+friction_static = 0.5
+friction_kinetic = 0.4
+self_collision = true
+"#;
+
+pub fn import(spec: &Path, out: Option<&Path>, form: &str, fabric: &str, grain_deg: f64, force: bool) -> ExitCode {
+    if !grain_deg.is_finite() {
+        return bad_input(format!("--grain-deg {grain_deg}: give a finite angle in degrees (90: the straight grain up and down each panel)"));
+    }
+    let text = match read_text(spec, FileKind::Pattern) {
+        Ok(t) => t,
+        Err(e) => return bad_input(e),
+    };
+    if !rosette::settings::FABRICS.iter().any(|b| b.name == fabric) {
+        let names: Vec<&str> = rosette::settings::FABRICS.iter().map(|b| b.name).collect();
+        return bad_input(format!("--fabric {fabric}: no such bundled fabric; use one of {}", names.join(", ")));
+    }
+    let form = FormConfig { size: Some(form.to_string()), ..FormConfig::default() };
+    let measurements = match form.measurements(rosette::garment::pattern::Units::Cm) {
+        Ok(Some(m)) => m,
+        Ok(None) => unreachable!("a size gives measurements"),
+        Err(e) => return bad_input(format!("--form: {e}")),
+    };
+    if let Some(path) = out {
+        let mut plan = Plan::new(force);
+        plan.add("--out", path, PATTERN_SCENE);
+        if let Err(e) = outputs::check(&plan, &[]) {
+            return bad_input(e);
+        }
+    }
+    let source = spec.display().to_string();
+    let imported = match import_spec(&text, &source, &ImportOptions { form, grain_deg }) {
+        Ok(i) => i,
+        Err(e) => return bad_input(e),
+    };
+    // The pattern is meshed here as a run would mesh it, so that an outline that crosses
+    // itself or a seam whose sides differ beyond the ease is refused now, naming the panel
+    // and the edge, not when the scene is first run.
+    if let Err(e) = rosette::garment::build(&imported.garment, 0.02, glam::DVec2::ZERO, &|level| measurements.level(level)) {
+        return bad_input(format!("{source}: {e}"));
+    }
+    for note in &imported.notes {
+        errln!("note: {note}");
+    }
+    #[derive(serde::Serialize)]
+    struct Section<'a> {
+        garment: &'a rosette::garment::GarmentConfig,
+    }
+    let garment = match toml::to_string(&Section { garment: &imported.garment }) {
+        Ok(t) => t,
+        Err(e) => return bad_input(format!("{source}: the garment cannot be written as TOML ({e})")),
+    };
+    let name = spec.file_stem().map_or_else(|| "pattern".into(), |s| s.to_string_lossy().replace(['"', '\\', '\n', '\r'], "'"));
+    let panels = imported.garment.panels.len();
+    let seams = imported.garment.seams.len();
+    let text = format!(
+        "# {name}: a garment imported from GarmentCode's pattern specification {}\n\
+         # Written by `rosette pattern import` ({panels} panels, {seams} seams). Lengths in [garment] are in cm;\n\
+         # each panel starts where GarmentCode places it, on a vertical plane facing out.\n\
+         [scene]\ndescription = \"{name} ({panels} panels, from GarmentCode) in {fabric}\"\n{SCENE}\n[fabric]\npreset = \"{fabric}\"\npoisson_warp = 0.0\n\n{garment}",
+        source.replace(['\n', '\r'], " "),
+    );
+    match out {
+        Some(path) => match rosette::io::write::whole(path, text.as_bytes()) {
+            Ok(()) => {
+                errln!("wrote {}; run it with `rosette run {}`", path.display(), path.display());
+                ExitCode::SUCCESS
+            }
+            Err(e) => lost_output(format!("--out {}: cannot write the scene file: {e}", path.display())),
+        },
+        None => {
+            out!("{text}");
+            ExitCode::SUCCESS
+        }
+    }
+}

@@ -1,0 +1,497 @@
+//! Patterns in GarmentCode's specification format (the JSON that GarmentCode and its
+//! dataset write: panels as 2D vertex loops with curved edges, each placed in 3D by a
+//! rotation and a translation around the body, and stitches between edges), turned into a
+//! `[garment]` section (docs/garments.md, "Importing a GarmentCode pattern").
+//!
+//! The format, as this reader takes it:
+//! - lengths in `properties.units_in_meter` (100: centimetres, the default);
+//! - a panel's edges form one loop (each starts where the last ended), counter-clockwise
+//!   seen from the garment's outside;
+//! - an edge's `curvature` is absent (straight), a quadratic Bézier control point, two cubic
+//!   ones, or a circular arc `[radius, large_arc, right]`; control points are in the edge's
+//!   own frame (`curvature_coords = "relative"`: x along the edge from its start, y the edge
+//!   turned a quarter counter-clockwise, both in edge lengths) or in the panel's;
+//! - a panel's points go to 3D as R·(x, y, 0) + translation, R the intrinsic x-y-z Euler
+//!   rotation (degrees), in a frame with y up from the floor and the body facing +z;
+//! - a stitch joins the end of its first edge to the start of its second (right sides
+//!   together) unless it carries `"right_wrong"`, which joins start to start.
+//!
+//! Rosette's panels start on vertical planes facing out from the form's axis
+//! (`Around::Plane`), so each panel's plane must be vertical; the rotation within it is
+//! taken into the outline, and a panel whose loop runs clockwise in its own coordinates
+//! (its outside faces its −z, the back panels) is mirrored so that it reads as seen from
+//! outside. Every point then lands where GarmentCode's own placement puts it.
+
+use super::GarmentError;
+use super::form::FormConfig;
+use super::pattern::{Around, EdgeConfig, PanelConfig, PlacementConfig, Units};
+use super::seams::{Direction, SeamConfig};
+use super::GarmentConfig;
+use glam::{DMat3, DVec2, DVec3};
+use serde::Deserialize;
+use serde_json::Value;
+use std::collections::BTreeMap;
+
+#[derive(Deserialize)]
+struct Spec {
+    pattern: SpecPattern,
+    #[serde(default)]
+    properties: Properties,
+}
+
+#[derive(Deserialize)]
+struct SpecPattern {
+    panels: BTreeMap<String, SpecPanel>,
+    #[serde(default)]
+    stitches: Vec<Vec<Value>>,
+    #[serde(default)]
+    panel_order: Option<Vec<String>>,
+}
+
+#[derive(Deserialize, Default)]
+struct Properties {
+    #[serde(default)]
+    curvature_coords: Option<String>,
+    #[serde(default)]
+    units_in_meter: Option<f64>,
+}
+
+#[derive(Deserialize)]
+struct SpecPanel {
+    translation: [f64; 3],
+    rotation: [f64; 3],
+    vertices: Vec<[f64; 2]>,
+    edges: Vec<SpecEdge>,
+}
+
+#[derive(Deserialize)]
+struct SpecEdge {
+    endpoints: [usize; 2],
+    #[serde(default)]
+    curvature: Option<Value>,
+}
+
+/// What an import gives: the garment section, and what the reader chose for the user to
+/// know (the hem it took, units assumed).
+pub struct Imported {
+    pub garment: GarmentConfig,
+    pub notes: Vec<String>,
+}
+
+/// Options of an import.
+pub struct ImportOptions {
+    /// The form the garment goes on.
+    pub form: FormConfig,
+    /// The warp's angle in every panel's own coordinates as GarmentCode drafts them,
+    /// degrees from its x axis (90: the straight grain runs up and down the panel).
+    pub grain_deg: f64,
+}
+
+/// Reads a GarmentCode specification (`text`, from `source`) into a `[garment]` section
+/// in centimetres.
+pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Imported, GarmentError> {
+    let bad = |m: String| GarmentError::new(format!("{source}: {m}"));
+    let spec: Spec = serde_json::from_str(text).map_err(|e| bad(format!("not a GarmentCode pattern specification ({e})")))?;
+    let mut notes = Vec::new();
+    let units_in_meter = match spec.properties.units_in_meter {
+        Some(u) if u.is_finite() && u > 0.0 => u,
+        Some(u) => return Err(bad(format!("properties.units_in_meter = {u} must be a positive number"))),
+        None => {
+            notes.push("properties.units_in_meter is missing: lengths taken as centimetres".into());
+            100.0
+        }
+    };
+    let relative = match spec.properties.curvature_coords.as_deref() {
+        None | Some("relative") => true,
+        Some("absolute") => false,
+        Some(other) => return Err(bad(format!("properties.curvature_coords = \"{other}\": use \"relative\" or \"absolute\""))),
+    };
+    if !options.grain_deg.is_finite() {
+        return Err(bad(format!("the grain angle {} must be a finite number of degrees", options.grain_deg)));
+    }
+    let order: Vec<String> = match &spec.pattern.panel_order {
+        Some(order) => {
+            for name in order {
+                if !spec.pattern.panels.contains_key(name) {
+                    return Err(bad(format!("pattern.panel_order names '{name}', which is not among pattern.panels")));
+                }
+            }
+            let mut order = order.clone();
+            order.extend(spec.pattern.panels.keys().filter(|k| !order.contains(k)).cloned().collect::<Vec<_>>());
+            order
+        }
+        None => spec.pattern.panels.keys().cloned().collect(),
+    };
+    if order.is_empty() {
+        return Err(bad("pattern.panels is empty".into()));
+    }
+    let to_cm = 100.0 / units_in_meter;
+    let mut panels = Vec::with_capacity(order.len());
+    // Each panel's lowest point and each edge's end heights, cm: the hem is found from them.
+    let mut heights: Vec<Vec<[f64; 2]>> = Vec::with_capacity(order.len());
+    for name in &order {
+        let (panel, edge_heights) = convert_panel(name, &spec.pattern.panels[name], relative, to_cm, options.grain_deg).map_err(bad)?;
+        panels.push(panel);
+        heights.push(edge_heights);
+    }
+    let mut seams = Vec::with_capacity(spec.pattern.stitches.len());
+    let mut stitched = vec![Vec::new(); order.len()];
+    for (i, stitch) in spec.pattern.stitches.iter().enumerate() {
+        let side = |j: usize| -> Result<(usize, usize), String> {
+            let key = format!("pattern.stitches[{i}][{j}]");
+            let entry = stitch.get(j).ok_or_else(|| format!("{key} is missing: a stitch joins two edges"))?;
+            let panel = entry.get("panel").and_then(Value::as_str).ok_or_else(|| format!("{key} needs a \"panel\" name"))?;
+            let edge = entry.get("edge").and_then(Value::as_u64).ok_or_else(|| format!("{key} needs an \"edge\" index"))? as usize;
+            let p = order.iter().position(|n| n == panel).ok_or_else(|| format!("{key}: no panel '{panel}'"))?;
+            if edge >= panels[p].edges.len() {
+                return Err(format!("{key}: panel '{panel}' has {} edges, no edge {edge}", panels[p].edges.len()));
+            }
+            Ok((p, edge))
+        };
+        let (a, b) = (side(0).map_err(bad)?, side(1).map_err(bad)?);
+        let direction = match stitch.get(2).and_then(Value::as_str) {
+            Some("right_wrong") => Direction::Same,
+            _ => Direction::Opposite,
+        };
+        stitched[a.0].push(a.1);
+        stitched[b.0].push(b.1);
+        let key = |(p, e): (usize, usize)| format!("{}.{}", order[p], panels[p].edges[e].name);
+        seams.push(SeamConfig { a: key(a), b: key(b), direction, a_span: None, b_span: None });
+    }
+    // GarmentCode gathers a seam whose sides differ (a bodice into a narrower skirt): the
+    // ease is set to the pattern's largest difference, up to what Rosette sews.
+    let mut ease = super::default_seam_ease();
+    let mut eased = Vec::new();
+    let lengths: Vec<Vec<f64>> = panels
+        .iter()
+        .map(|p| p.curves(0.01).map(|c| c.iter().map(|e| e.length()).collect()))
+        .collect::<Result<_, _>>()
+        .map_err(|e| bad(e.message))?;
+    for (i, s) in spec.pattern.stitches.iter().enumerate() {
+        let side = |j: usize| {
+            let panel = order.iter().position(|n| Some(n.as_str()) == s[j].get("panel").and_then(Value::as_str)).expect("resolved above");
+            lengths[panel][s[j]["edge"].as_u64().expect("resolved above") as usize]
+        };
+        let (la, lb) = (side(0), side(1));
+        let share = (la - lb).abs() / la.max(lb);
+        if share > super::default_seam_ease() {
+            eased.push(format!("stitch {i} ({:.0} %)", 100.0 * share));
+            ease = ease.max((100.0 * share + 1.0).ceil() / 100.0);
+        }
+    }
+    if !eased.is_empty() {
+        notes.push(format!("garment.seam_ease = {ease}: GarmentCode gathers {}", eased.join(", ")));
+    }
+    // The hem: the free edges (in no stitch) at the garment's bottom, both ends within
+    // HEM_BAND of its lowest point.
+    const HEM_BAND: f64 = 3.0;
+    let lowest = heights.iter().flatten().flatten().copied().fold(f64::INFINITY, f64::min);
+    let mut hem = Vec::new();
+    for (p, edges) in heights.iter().enumerate() {
+        for (e, ends) in edges.iter().enumerate() {
+            if !stitched[p].contains(&e) && ends.iter().all(|&z| z < lowest + HEM_BAND) {
+                hem.push(format!("{}.{}", order[p], panels[p].edges[e].name));
+            }
+        }
+    }
+    notes.push(if hem.is_empty() { "no free edge at the garment's bottom: no hem".into() } else { format!("hem: {}", hem.join(", ")) });
+    let garment = GarmentConfig {
+        units: Units::Cm,
+        form: options.form.clone(),
+        panels,
+        seams,
+        attachments: Vec::new(),
+        hem,
+        seam_ease: ease,
+        sewing_stiffness: super::default_sewing_stiffness(),
+        sewing_ramp: super::default_sewing_ramp(),
+        sewing_damping: super::default_sewing_damping(),
+        sewing_time: super::default_sewing_time(),
+        closed_share: super::default_closed_share(),
+    };
+    Ok(Imported { garment, notes })
+}
+
+/// GarmentCode's frame (y up, the body facing +z) in Rosette's (z up, the form facing −y).
+fn to_rosette(v: DVec3) -> DVec3 {
+    DVec3::new(v.x, -v.z, v.y)
+}
+
+/// GarmentCode's rotation: intrinsic x-y-z Euler angles in degrees, R = Rz·Ry·Rx.
+fn rotation(euler: [f64; 3]) -> DMat3 {
+    let [x, y, z] = euler.map(f64::to_radians);
+    DMat3::from_rotation_z(z) * DMat3::from_rotation_y(y) * DMat3::from_rotation_x(x)
+}
+
+/// One panel as Rosette's, with each edge's end heights above the floor (cm).
+fn convert_panel(name: &str, panel: &SpecPanel, relative: bool, to_cm: f64, grain_deg: f64) -> Result<(PanelConfig, Vec<[f64; 2]>), String> {
+    let at = |m: String| format!("panel '{name}': {m}");
+    let finite = panel.translation.iter().chain(&panel.rotation).chain(panel.vertices.iter().flatten()).all(|v| v.is_finite());
+    if !finite {
+        return Err(at("a translation, rotation or vertex value is not a finite number".into()));
+    }
+    let n = panel.edges.len();
+    if n < 2 {
+        return Err(at(format!("{n} edges cannot close an outline")));
+    }
+    for (i, e) in panel.edges.iter().enumerate() {
+        if let Some(&v) = e.endpoints.iter().find(|&&v| v >= panel.vertices.len()) {
+            return Err(at(format!("edge {i} names vertex {v}, but the panel has {} vertices", panel.vertices.len())));
+        }
+        let next = &panel.edges[(i + 1) % n];
+        if e.endpoints[1] != next.endpoints[0] {
+            return Err(at(format!("edge {i} ends at vertex {} but edge {} starts at vertex {}: the edges must form one loop", e.endpoints[1], (i + 1) % n, next.endpoints[0])));
+        }
+    }
+    let vertex = |i: usize| DVec2::from_array(panel.vertices[i]);
+    // Counter-clockwise seen from outside: a loop that runs clockwise in the panel's own
+    // coordinates faces out along its −z and is mirrored (x → −x) to read from outside.
+    let area: f64 = panel.edges.iter().map(|e| vertex(e.endpoints[0]).perp_dot(vertex(e.endpoints[1]))).sum::<f64>() * 0.5;
+    if area.abs() < 1e-12 {
+        return Err(at("its outline encloses no area".into()));
+    }
+    let mirror = if area > 0.0 { 1.0 } else { -1.0 };
+    let r = rotation(panel.rotation);
+    let outward = to_rosette(mirror * r.z_axis);
+    if outward.z.abs() > 1e-6 {
+        return Err(at(format!(
+            "its rotation {:?} tilts it out of the vertical; Rosette starts panels on vertical planes around the form",
+            panel.rotation
+        )));
+    }
+    let out = DVec2::new(outward.x, outward.y).normalize();
+    let tangent = DVec3::new(-out.y, out.x, 0.0);
+    // The panel's axes as seen from outside, in Rosette's frame: x' = mirror·x, y' = y; the
+    // rotation within the plane is θ from the plane's horizontal tangent.
+    let (ex, ey) = (to_rosette(mirror * r.x_axis), to_rosette(r.y_axis));
+    let theta = ex.z.atan2(ex.dot(tangent));
+    let (sin, cos) = theta.sin_cos();
+    if (ey.dot(tangent) + sin).abs() > 1e-6 || (ey.z - cos).abs() > 1e-6 {
+        return Err(at("its rotation is not a rotation (the panel's axes do not stay square)".into()));
+    }
+    let plane = |p: DVec2| -> DVec2 {
+        let q = DVec2::new(mirror * p.x, p.y);
+        DVec2::new(cos * q.x - sin * q.y, sin * q.x + cos * q.y) * to_cm
+    };
+    let translation = to_rosette(DVec3::from_array(panel.translation)) * to_cm;
+    let horizontal = DVec2::new(translation.x, translation.y);
+    let distance = horizontal.dot(out);
+    if distance <= 0.0 {
+        return Err(at(format!("it faces the body's axis from {:.1} cm behind it; its outside must face away from the body", -distance)));
+    }
+    let along = horizontal.dot(DVec2::new(tangent.x, tangent.y));
+    let placement = PlacementConfig { around: Around::Plane, angle_deg: out.y.atan2(out.x).to_degrees().rem_euclid(360.0), distance, height: translation.z, flare_deg: 0.0 };
+    let anchor = DVec2::new(-along, 0.0);
+    let height = |p: DVec2| translation.z + p.y;
+    let mut edges = Vec::with_capacity(n);
+    let mut edge_heights = Vec::with_capacity(n);
+    for (i, e) in panel.edges.iter().enumerate() {
+        let (start, end) = (vertex(e.endpoints[0]), vertex(e.endpoints[1]));
+        let point = |p: [f64; 2]| -> DVec2 {
+            let p = DVec2::from_array(p);
+            if relative {
+                let chord = end - start;
+                start + p.x * chord + p.y * chord.perp()
+            } else {
+                p
+            }
+        };
+        let key = |m: &str| at(format!("edge {i}: {m}"));
+        let (mut through, mut controls) = (None, None);
+        match &e.curvature {
+            None | Some(Value::Null) => {}
+            Some(c) => {
+                let kind = if c.is_array() { "quadratic" } else { c.get("type").and_then(Value::as_str).ok_or_else(|| key("curvature has no \"type\""))? };
+                let params = if c.is_array() { Value::Array(vec![c.clone()]) } else { c.get("params").cloned().unwrap_or(Value::Null) };
+                let pair = |v: &Value| -> Result<[f64; 2], String> {
+                    let p: [f64; 2] = serde_json::from_value(v.clone()).map_err(|_| key("a control point must be two numbers"))?;
+                    if p.iter().all(|x| x.is_finite()) { Ok(p) } else { Err(key("a control point is not finite")) }
+                };
+                let list = params.as_array().cloned().unwrap_or_default();
+                match kind {
+                    "quadratic" => {
+                        let q = point(pair(list.first().ok_or_else(|| key("a quadratic curve needs one control point"))?)?);
+                        // The same curve as a cubic: control points two thirds of the way to q.
+                        controls = Some([start + (q - start) * (2.0 / 3.0), end + (q - end) * (2.0 / 3.0)]);
+                    }
+                    "cubic" => {
+                        if list.len() != 2 {
+                            return Err(key("a cubic curve needs two control points"));
+                        }
+                        controls = Some([point(pair(&list[0])?), point(pair(&list[1])?)]);
+                    }
+                    "circle" => {
+                        let radius = list.first().and_then(Value::as_f64).filter(|r| r.is_finite() && *r > 0.0).ok_or_else(|| key("a circle needs a positive radius"))?;
+                        let flag = |j: usize| list.get(j).and_then(|v| v.as_bool().or_else(|| v.as_f64().map(|x| x != 0.0)));
+                        let (Some(large), Some(right)) = (flag(1), flag(2)) else {
+                            return Err(key("a circle's params are [radius, large_arc, right]"));
+                        };
+                        through = Some(arc_midpoint(start, end, radius, large, right).ok_or_else(|| key(&format!("radius {radius} is shorter than half the edge's chord")))?);
+                    }
+                    other => return Err(key(&format!("unknown curvature type \"{other}\" (quadratic, cubic or circle)"))),
+                }
+            }
+        }
+        edges.push(EdgeConfig {
+            name: format!("e{i}"),
+            to: plane(end).to_array(),
+            through: through.map(|t| plane(t).to_array()),
+            controls: controls.map(|[a, b]| [plane(a).to_array(), plane(b).to_array()]),
+        });
+        edge_heights.push([height(plane(start)), height(plane(end))]);
+    }
+    let grain = if mirror > 0.0 { grain_deg } else { 180.0 - grain_deg } + theta.to_degrees();
+    let panel = PanelConfig {
+        name: name.to_string(),
+        grain_deg: grain.rem_euclid(360.0),
+        start: plane(vertex(panel.edges[0].endpoints[0])).to_array(),
+        edges,
+        anchor: Some(anchor.to_array()),
+        placement,
+    };
+    Ok((panel, edge_heights))
+}
+
+/// The middle of the circular arc of `radius` from `start` to `end`: the short or long
+/// arc (`large`), bulging to the right of the chord when `right` (GarmentCode draws it
+/// counter-clockwise from start to end then). None when the radius cannot span the chord.
+fn arc_midpoint(start: DVec2, end: DVec2, radius: f64, large: bool, right: bool) -> Option<DVec2> {
+    let chord = end - start;
+    let half = 0.5 * chord.length();
+    // A radius equal to half the chord, written to a few digits, may fall short of it by
+    // rounding: a half circle.
+    if radius < half * (1.0 - 1e-6) || half == 0.0 {
+        return None;
+    }
+    let rise = (radius * radius - half * half).max(0.0).sqrt();
+    let sagitta = if large { radius + rise } else { radius - rise };
+    let normal = DVec2::new(chord.y, -chord.x) / chord.length();
+    Some(0.5 * (start + end) + sagitta * if right { normal } else { -normal })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::garment::place::Placement;
+
+    fn options() -> ImportOptions {
+        ImportOptions { form: FormConfig { size: Some("uk-12".into()), ..FormConfig::default() }, grain_deg: 90.0 }
+    }
+
+    /// A front and a back panel (the back clockwise in its own coordinates, as GarmentCode
+    /// writes it) and a sleeve turned within its plane, with the three curve kinds.
+    const SPEC: &str = r#"{
+      "pattern": {
+        "panels": {
+          "front": { "translation": [-20, 80, 25], "rotation": [0, 0, 0],
+            "vertices": [[0, 0], [40, 0], [38, 30], [2, 30]],
+            "edges": [ {"endpoints": [0, 1]}, {"endpoints": [1, 2]},
+                       {"endpoints": [2, 3], "curvature": {"type": "quadratic", "params": [[0.5, 0.1]]}},
+                       {"endpoints": [3, 0]} ] },
+          "back": { "translation": [20, 80, -20], "rotation": [0, 0, 0],
+            "vertices": [[0, 0], [-40, 0], [-38, 30], [-2, 30]],
+            "edges": [ {"endpoints": [0, 1]}, {"endpoints": [1, 2]},
+                       {"endpoints": [2, 3], "curvature": {"type": "cubic", "params": [[0.3, -0.1], [0.7, -0.1]]}},
+                       {"endpoints": [3, 0]} ] },
+          "sleeve": { "translation": [40, 100, 5], "rotation": [0, 0, -50],
+            "vertices": [[0, 0], [20, 0], [20, 10], [0, 10]],
+            "edges": [ {"endpoints": [0, 1]}, {"endpoints": [1, 2]},
+                       {"endpoints": [2, 3], "curvature": {"type": "circle", "params": [12, 0, 1]}},
+                       {"endpoints": [3, 0]} ] }
+        },
+        "stitches": [
+          [{"panel": "front", "edge": 1}, {"panel": "back", "edge": 3}],
+          [{"panel": "front", "edge": 3}, {"panel": "back", "edge": 1}, "right_wrong"]
+        ]
+      },
+      "properties": {"curvature_coords": "relative", "units_in_meter": 100}
+    }"#;
+
+    /// Every panel point lands, through Rosette's placement, where GarmentCode's own
+    /// transform R·(x, y, 0) + t puts it (computed here from the specification directly).
+    #[test]
+    fn panels_land_where_garmentcode_places_them() {
+        let imported = import(SPEC, "test.json", &options()).unwrap();
+        let spec: Spec = serde_json::from_str(SPEC).unwrap();
+        for panel in &imported.garment.panels {
+            let source = &spec.pattern.panels[&panel.name];
+            let r = rotation(source.rotation);
+            let place = Placement::new(&panel.placement, DVec2::from_array(panel.anchor.unwrap()) * 0.01, DVec2::ZERO, 0.01);
+            let ours = std::iter::once(panel.start).chain(panel.edges.iter().map(|e| e.to));
+            let theirs = source.edges.iter().map(|e| source.vertices[e.endpoints[0]]).chain(std::iter::once(source.vertices[source.edges[0].endpoints[0]]));
+            for (p, q) in ours.zip(theirs) {
+                let expect = 0.01 * DVec3::new(
+                    (r * DVec3::new(q[0], q[1], 0.0)).x + source.translation[0],
+                    -((r * DVec3::new(q[0], q[1], 0.0)).z + source.translation[2]),
+                    (r * DVec3::new(q[0], q[1], 0.0)).y + source.translation[1],
+                );
+                let got = place.position(DVec2::from_array(p) * 0.01);
+                assert!((got - expect).length() < 1e-12, "{}: {got} against {expect}", panel.name);
+            }
+        }
+    }
+
+    /// Outlines come out counter-clockwise (the back mirrored), lengths kept; stitches
+    /// keep GarmentCode's pairing; the hem is the free bottom edges.
+    #[test]
+    fn outlines_seams_and_hem() {
+        let imported = import(SPEC, "test.json", &options()).unwrap();
+        let g = &imported.garment;
+        for panel in &g.panels {
+            let points: Vec<DVec2> = std::iter::once(panel.start).chain(panel.edges.iter().map(|e| e.to)).map(DVec2::from_array).collect();
+            let area: f64 = points.windows(2).map(|w| w[0].perp_dot(w[1])).sum();
+            assert!(area > 0.0, "{} runs clockwise", panel.name);
+        }
+        let front = &g.panels.iter().find(|p| p.name == "front").unwrap();
+        // Straight edge 1 of the front, (40, 0) to (38, 30), keeps its length.
+        let e1 = DVec2::from_array(front.edges[1].to).distance(DVec2::from_array(front.edges[0].to));
+        assert!((e1 - (4.0f64 + 900.0).sqrt()).abs() < 1e-12);
+        // A quadratic with control q: cubic controls at 2/3 towards q; q = mid-chord + 0.1 × the
+        // chord (−36, 0) turned counter-clockwise = (20, 30) + (0, −3.6).
+        let [c1, _] = front.edges[2].controls.unwrap();
+        let q = DVec2::new(20.0, 26.4);
+        let expect = DVec2::new(38.0, 30.0) + (q - DVec2::new(38.0, 30.0)) * (2.0 / 3.0);
+        assert!((DVec2::from_array(c1) - expect).length() < 1e-9, "{c1:?}");
+        assert_eq!(g.seams[0].direction, Direction::Opposite);
+        assert_eq!(g.seams[1].direction, Direction::Same);
+        assert_eq!((g.seams[0].a.as_str(), g.seams[0].b.as_str()), ("front.e1", "back.e3"));
+        assert_eq!(g.hem, vec!["back.e0".to_string(), "front.e0".to_string()]);
+        // The front panel faces −y (angle 270°) at 25 cm; the back +y at 20 cm.
+        assert!((front.placement.angle_deg - 270.0).abs() < 1e-9 && (front.placement.distance - 25.0).abs() < 1e-9);
+        let back = g.panels.iter().find(|p| p.name == "back").unwrap();
+        assert!((back.placement.angle_deg - 90.0).abs() < 1e-9 && (back.placement.distance - 20.0).abs() < 1e-9);
+    }
+
+    /// GarmentCode's circle: the short arc of radius 12 over a 20-long chord, drawn
+    /// counter-clockwise (bulging right of the chord), has its middle 12 − √(144 − 100) off
+    /// the chord.
+    #[test]
+    fn arc_middle_from_radius_and_flags() {
+        let (a, b) = (DVec2::new(20.0, 10.0), DVec2::new(0.0, 10.0));
+        let sagitta = 12.0 - (44.0f64).sqrt();
+        let right = arc_midpoint(a, b, 12.0, false, true).unwrap();
+        assert!((right - DVec2::new(10.0, 10.0 + sagitta)).length() < 1e-12, "{right}");
+        let long_left = arc_midpoint(a, b, 12.0, true, false).unwrap();
+        assert!((long_left - DVec2::new(10.0, 10.0 - (12.0 + 44f64.sqrt()))).length() < 1e-12);
+        assert!(arc_midpoint(a, b, 9.0, false, true).is_none());
+    }
+
+    /// Bad specifications are refused naming the panel and the edge.
+    #[test]
+    fn bad_specifications_name_the_panel_and_edge() {
+        // The front panel comes first in the text: its edge 1 made to end at vertex 3.
+        let broken = SPEC.replacen(r#"{"endpoints": [1, 2]}"#, r#"{"endpoints": [1, 3]}"#, 1);
+        let e = import(&broken, "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("panel 'front'") && e.contains("edge 1") && e.contains("loop"), "{e}");
+        let tilted = SPEC.replace(r#""rotation": [0, 0, -50]"#, r#""rotation": [30, 0, 0]"#);
+        let e = import(&tilted, "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("panel 'sleeve'") && e.contains("vertical"), "{e}");
+        let unknown = SPEC.replace(r#""type": "cubic""#, r#""type": "spline""#);
+        let e = import(&unknown, "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("panel 'back'") && e.contains("edge 2") && e.contains("spline"), "{e}");
+        let missing = SPEC.replace(r#"{"panel": "back", "edge": 3}"#, r#"{"panel": "back", "edge": 7}"#);
+        let e = import(&missing, "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("stitches[0][1]") && e.contains("no edge 7"), "{e}");
+        assert!(import("{", "x.json", &options()).is_err());
+    }
+}
