@@ -396,3 +396,25 @@ fn an_imported_garmentcode_pattern_sews_and_stays_clean() {
     let said = String::from_utf8_lossy(&refused.stderr);
     assert!(said.contains("not-a-pattern.json") && said.contains("not a GarmentCode pattern specification"), "{said}");
 }
+
+/// A GarmentCode specification given where a scene goes (`rosette run SPEC.json`, the
+/// viewer's Open) is the scene `rosette pattern import` writes for it with its defaults, and
+/// takes `--set` like any scene; a broken one is refused naming the file, panel and edge.
+#[test]
+fn a_garmentcode_specification_runs_as_a_scene() {
+    let spec = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/patterns/aline-skirt_specification.json");
+    let (config, file) = load_scene(spec, &["mesh.edge_length=0.05".into(), "fabric.preset=\"denim\"".into()]).unwrap();
+    assert!(file.ends_with("aline-skirt_specification.json"), "{file}");
+    let garment = config.garment.as_ref().expect("a garment scene");
+    assert_eq!(garment.panels.len(), 2);
+    assert_eq!(garment.seams.len(), 4);
+    assert_eq!(garment.form.size.as_deref(), Some("uk-14"));
+    assert_eq!(config.mesh.edge_length, 0.05);
+    assert_eq!(config.fabric.preset.as_deref(), Some("denim"));
+    Scene::build(config).unwrap();
+    let broken = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("broken_specification.json");
+    let text = std::fs::read_to_string(spec).unwrap().replacen(r#"{"endpoints": [1, 2]"#, r#"{"endpoints": [1, 3]"#, 1);
+    std::fs::write(&broken, text).unwrap();
+    let err = load_scene(broken.to_str().unwrap(), &[]).expect_err("a broken loop is refused").to_string();
+    assert!(err.contains("broken_specification.json") && err.contains("panel 'skirt_front'") && err.contains("edge 1"), "{err}");
+}

@@ -362,7 +362,12 @@ impl App {
                 FileDialog::ExportCsv => ("CSV", "csv"),
                 FileDialog::ExportGltf => ("glTF binary", "glb"),
             };
-            let dialog = rfd::FileDialog::new().add_filter(filter, &[extension]);
+            let mut dialog = rfd::FileDialog::new().add_filter(filter, &[extension]);
+            if let FileDialog::OpenScene = kind {
+                // A GarmentCode pattern opens as the garment scene `rosette pattern import`
+                // would write for it.
+                dialog = dialog.add_filter("GarmentCode pattern", &["json"]);
+            }
             let path = match kind {
                 FileDialog::OpenScene | FileDialog::OpenFabric => dialog.pick_file(),
                 _ => dialog.set_file_name(format!("{scene}.{extension}")).save_file(),

@@ -260,7 +260,7 @@ pub enum PatternAction {
         #[arg(long, default_value = "uk-14")]
         form: String,
         /// The fabric (a bundled name, see `rosette fabric list`).
-        #[arg(long, default_value = "cotton-shirting")]
+        #[arg(long, default_value = rosette::garment::garmentcode::DEFAULT_FABRIC)]
         fabric: String,
         /// The warp's angle in each panel as drafted, degrees from its x axis: 90 runs it
         /// up and down the panel (straight grain), 45 or 135 cuts every panel on the bias.

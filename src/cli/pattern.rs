@@ -3,41 +3,12 @@
 use super::outputs::{self, PATTERN_SCENE};
 use super::{bad_input, lost_output};
 use rosette::garment::form::FormConfig;
-use rosette::garment::garmentcode::{ImportOptions, import as import_spec};
+use rosette::garment::garmentcode::{ImportOptions, import as import_spec, scene_text};
 use rosette::io::guard::Plan;
 use rosette::io::read::{FileKind, read_text};
 use rosette::{errln, out};
 use std::path::Path;
 use std::process::ExitCode;
-
-/// The scene around an imported pattern: the bundled garments' settings (docs/garments.md),
-/// the mesh at 2 cm.
-const SCENE: &str = r#"kind = "garment"
-duration = 6.0
-gravity_ramp = 1.5
-settle_speed = 1e-3
-settle_window = 0.3
-
-[physics]
-compression_buckling = true
-
-[mesh]
-edge_length = 0.02
-
-[solver]
-integrator = "implicit-euler"
-dt = 0.004
-damping = 4.0
-
-[solver.newton]
-max_iterations = 100
-
-[contact]
-thickness = 0.002
-friction_static = 0.5
-friction_kinetic = 0.4
-self_collision = true
-"#;
 
 pub fn import(spec: &Path, out: Option<&Path>, form: &str, fabric: &str, grain_deg: f64, force: bool) -> ExitCode {
     if !grain_deg.is_finite() {
@@ -78,24 +49,11 @@ pub fn import(spec: &Path, out: Option<&Path>, form: &str, fabric: &str, grain_d
     for note in &imported.notes {
         errln!("note: {note}");
     }
-    #[derive(serde::Serialize)]
-    struct Section<'a> {
-        garment: &'a rosette::garment::GarmentConfig,
-    }
-    let garment = match toml::to_string(&Section { garment: &imported.garment }) {
+    let name = spec.file_stem().map_or_else(|| "pattern".into(), |s| s.to_string_lossy().into_owned());
+    let text = match scene_text(&imported, &source, &name, fabric) {
         Ok(t) => t,
-        Err(e) => return bad_input(format!("{source}: the garment cannot be written as TOML ({e})")),
+        Err(e) => return bad_input(e),
     };
-    let name = spec.file_stem().map_or_else(|| "pattern".into(), |s| s.to_string_lossy().replace(['"', '\\', '\n', '\r'], "'"));
-    let panels = imported.garment.panels.len();
-    let seams = imported.garment.seams.len();
-    let text = format!(
-        "# {name}: a garment imported from GarmentCode's pattern specification {}\n\
-         # Written by `rosette pattern import` ({panels} panels, {seams} seams). Lengths in [garment] are in cm;\n\
-         # each panel starts where GarmentCode places it, on a vertical plane facing out.\n\
-         [scene]\ndescription = \"{name} ({panels} panels, from GarmentCode) in {fabric}\"\n{SCENE}\n[fabric]\npreset = \"{fabric}\"\npoisson_warp = 0.0\n\n{garment}",
-        source.replace(['\n', '\r'], " "),
-    );
     match out {
         Some(path) => match rosette::io::write::whole(path, text.as_bytes()) {
             Ok(()) => {

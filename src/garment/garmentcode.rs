@@ -87,6 +87,65 @@ pub struct ImportOptions {
     pub grain_deg: f64,
 }
 
+impl Default for ImportOptions {
+    /// The largest bundled form and the straight grain.
+    fn default() -> Self {
+        Self { form: FormConfig { size: Some("uk-14".into()), ..FormConfig::default() }, grain_deg: 90.0 }
+    }
+}
+
+/// The fabric an imported garment is made of unless one is named.
+pub const DEFAULT_FABRIC: &str = "cotton-shirting";
+
+/// The scene around an imported pattern: the bundled garments' settings (docs/garments.md),
+/// the mesh at 2 cm.
+const SCENE: &str = r#"kind = "garment"
+duration = 6.0
+gravity_ramp = 1.5
+settle_speed = 1e-3
+settle_window = 0.3
+
+[physics]
+compression_buckling = true
+
+[mesh]
+edge_length = 0.02
+
+[solver]
+integrator = "implicit-euler"
+dt = 0.004
+damping = 4.0
+
+[solver.newton]
+max_iterations = 100
+
+[contact]
+thickness = 0.002
+friction_static = 0.5
+friction_kinetic = 0.4
+self_collision = true
+"#;
+
+/// The scene file of an imported garment named `name`, read from `source`, in `fabric`.
+pub fn scene_text(imported: &Imported, source: &str, name: &str, fabric: &str) -> Result<String, GarmentError> {
+    #[derive(serde::Serialize)]
+    struct Section<'a> {
+        garment: &'a GarmentConfig,
+    }
+    let garment = toml::to_string(&Section { garment: &imported.garment })
+        .map_err(|e| GarmentError::new(format!("{source}: the garment cannot be written as TOML ({e})")))?;
+    let name = name.replace(['"', '\\', '\n', '\r'], "'");
+    let fabric = fabric.replace(['"', '\\', '\n', '\r'], "'");
+    let (panels, seams) = (imported.garment.panels.len(), imported.garment.seams.len());
+    Ok(format!(
+        "# {name}: a garment imported from GarmentCode's pattern specification {}\n\
+         # Written by `rosette pattern import` ({panels} panels, {seams} seams). Lengths in [garment] are in cm;\n\
+         # each panel starts where GarmentCode places it, on a vertical plane facing out.\n\
+         [scene]\ndescription = \"{name} ({panels} panels, from GarmentCode) in {fabric}\"\n{SCENE}\n[fabric]\npreset = \"{fabric}\"\npoisson_warp = 0.0\n\n{garment}",
+        source.replace(['\n', '\r'], " "),
+    ))
+}
+
 /// Reads a GarmentCode specification (`text`, from `source`) into a `[garment]` section
 /// in centimetres.
 pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Imported, GarmentError> {

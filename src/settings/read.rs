@@ -81,8 +81,9 @@ pub fn read_preset(kind: PresetKind, spec: &str, base: Option<&Path>, key: Optio
             path = candidate;
         }
     }
-    let arcsim = kind == PresetKind::Fabric && is_arcsim_file(spec);
-    if !path.exists() && !looks_like_path(spec) && !arcsim {
+    let json = is_arcsim_file(spec);
+    let arcsim = kind == PresetKind::Fabric && json;
+    if !path.exists() && !looks_like_path(spec) && !json {
         let available = list.iter().map(|b| b.name).collect::<Vec<_>>().join(", ");
         return Err(PresetError::Unknown { kind: kind.name(), name: spec.to_string(), available });
     }
@@ -91,12 +92,31 @@ pub fn read_preset(kind: PresetKind, spec: &str, base: Option<&Path>, key: Optio
         read_text(&path, FileKind::Arcsim).map_err(|source| PresetError::Read { key, source })?;
         return Ok((arcsim_fabric_table(&file), file));
     }
+    if kind == PresetKind::Scene && json {
+        return garment_pattern_table(&path, &file, key).map(|table| (table, file));
+    }
     let text = read_text(&path, kind.file_kind()).map_err(|source| PresetError::Read { key, source })?;
     let table = parse_toml(&text, Some(&path), kind.file_kind()).map_err(|message| PresetError::Syntax { file: file.clone(), message })?;
     if kind == PresetKind::Fabric {
         refuse_fabric_preset(&table).map_err(|message| PresetError::Invalid { file: file.clone(), message })?;
     }
     Ok((table, file))
+}
+
+/// The scene table a GarmentCode pattern specification (`….json`) stands for: the scene
+/// `rosette pattern import` would write for it with its defaults (docs/garments.md).
+fn garment_pattern_table(path: &Path, file: &str, key: Option<&'static str>) -> Result<toml::Table, PresetError> {
+    use crate::garment::garmentcode::{DEFAULT_FABRIC, ImportOptions, import, scene_text};
+    let text = read_text(path, FileKind::Pattern).map_err(|source| PresetError::Read { key, source })?;
+    // The reader's messages start with the file's name, which `Invalid` gives.
+    let invalid = |e: crate::garment::GarmentError| {
+        let message = e.message.strip_prefix(&format!("{file}: ")).map_or(e.message.clone(), str::to_string);
+        PresetError::Invalid { file: file.to_string(), message }
+    };
+    let imported = import(&text, file, &ImportOptions::default()).map_err(invalid)?;
+    let name = path.file_stem().map_or_else(|| "pattern".into(), |s| s.to_string_lossy().into_owned());
+    let scene = scene_text(&imported, file, &name, DEFAULT_FABRIC).map_err(invalid)?;
+    parse_table(&scene, file)
 }
 
 /// The fabric table an ARCSim material file `file` (`….json`) stands for: named after the
