@@ -194,6 +194,8 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
         heights.push(edge_heights);
     }
     let mut seams = Vec::with_capacity(spec.pattern.stitches.len());
+    // Each stitch's two sides as (panel, edge).
+    let mut sides = Vec::with_capacity(spec.pattern.stitches.len());
     let mut stitched = vec![Vec::new(); order.len()];
     for (i, stitch) in spec.pattern.stitches.iter().enumerate() {
         let side = |j: usize| -> Result<(usize, usize), String> {
@@ -214,6 +216,7 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
         };
         stitched[a.0].push(a.1);
         stitched[b.0].push(b.1);
+        sides.push((a, b));
         let key = |(p, e): (usize, usize)| format!("{}.{}", order[p], panels[p].edges[e].name);
         seams.push(SeamConfig { a: key(a), b: key(b), direction, a_span: None, b_span: None });
     }
@@ -223,19 +226,24 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
     let mut eased = Vec::new();
     let lengths: Vec<Vec<f64>> = panels
         .iter()
-        .map(|p| p.curves(0.01).map(|c| c.iter().map(|e| e.length()).collect()))
+        .map(|p| p.curves(1.0).map(|c| c.iter().map(|e| e.length()).collect()))
         .collect::<Result<_, _>>()
         .map_err(|e| bad(e.message))?;
-    for (i, s) in spec.pattern.stitches.iter().enumerate() {
-        let side = |j: usize| {
-            let panel = order.iter().position(|n| Some(n.as_str()) == s[j].get("panel").and_then(Value::as_str)).expect("resolved above");
-            lengths[panel][s[j]["edge"].as_u64().expect("resolved above") as usize]
-        };
-        let (la, lb) = (side(0), side(1));
+    for (i, &((pa, ea), (pb, eb))) in sides.iter().enumerate() {
+        let (la, lb) = (lengths[pa][ea], lengths[pb][eb]);
         let share = (la - lb).abs() / la.max(lb);
+        if share >= MAX_EASE {
+            return Err(bad(format!(
+                "pattern.stitches[{i}]: {}.e{ea} ({la:.1} cm) and {}.e{eb} ({lb:.1} cm) differ by {:.0} %; Rosette gathers a seam by at most {:.0} %",
+                order[pa],
+                order[pb],
+                100.0 * share,
+                100.0 * MAX_EASE
+            )));
+        }
         if share > super::default_seam_ease() {
             eased.push(format!("stitch {i} ({:.0} %)", 100.0 * share));
-            ease = ease.max((100.0 * share + 1.0).ceil() / 100.0);
+            ease = ease.max(((100.0 * share + 1.0).ceil() / 100.0).min(MAX_EASE));
         }
     }
     if !eased.is_empty() {
@@ -270,6 +278,10 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
     };
     Ok(Imported { garment, notes })
 }
+
+/// The largest relative difference between a seam's sides that an import sets
+/// `garment.seam_ease` to (Rosette takes shares under a half).
+const MAX_EASE: f64 = 0.49;
 
 /// GarmentCode's frame (y up, the body facing +z) in Rosette's (z up, the form facing −y).
 fn to_rosette(v: DVec3) -> DVec3 {
@@ -551,6 +563,9 @@ mod tests {
         let missing = SPEC.replace(r#"{"panel": "back", "edge": 3}"#, r#"{"panel": "back", "edge": 7}"#);
         let e = import(&missing, "x.json", &options()).err().unwrap().message;
         assert!(e.contains("stitches[0][1]") && e.contains("no edge 7"), "{e}");
+        let gathered = SPEC.replacen(r#""stitches": ["#, r#""stitches": [[{"panel": "front", "edge": 0}, {"panel": "sleeve", "edge": 1}], "#, 1);
+        let e = import(&gathered, "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("stitches[0]") && e.contains("front.e0 (40.0 cm)") && e.contains("sleeve.e1 (10.0 cm)") && e.contains("75 %"), "{e}");
         assert!(import("{", "x.json", &options()).is_err());
     }
 }
