@@ -249,18 +249,7 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
     if !eased.is_empty() {
         notes.push(format!("garment.seam_ease = {ease}: GarmentCode gathers {}", eased.join(", ")));
     }
-    // The hem: the free edges (in no stitch) at the garment's bottom, both ends within
-    // HEM_BAND of its lowest point.
-    const HEM_BAND: f64 = 3.0;
-    let lowest = heights.iter().flatten().flatten().copied().fold(f64::INFINITY, f64::min);
-    let mut hem = Vec::new();
-    for (p, edges) in heights.iter().enumerate() {
-        for (e, ends) in edges.iter().enumerate() {
-            if !stitched[p].contains(&e) && ends.iter().all(|&z| z < lowest + HEM_BAND) {
-                hem.push(format!("{}.{}", order[p], panels[p].edges[e].name));
-            }
-        }
-    }
+    let hem = hem_edges(&order, &panels, &heights, &stitched);
     notes.push(if hem.is_empty() { "no free edge at the garment's bottom: no hem".into() } else { format!("hem: {}", hem.join(", ")) });
     let garment = GarmentConfig {
         units: Units::Cm,
@@ -277,6 +266,22 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
         closed_share: super::default_closed_share(),
     };
     Ok(Imported { garment, notes })
+}
+
+/// The hem: the free edges (in no stitch) at the garment's bottom, both ends (`heights`,
+/// cm, by panel and edge) within HEM_BAND of its lowest point, as `panel.edge`.
+fn hem_edges(order: &[String], panels: &[PanelConfig], heights: &[Vec<[f64; 2]>], stitched: &[Vec<usize>]) -> Vec<String> {
+    const HEM_BAND: f64 = 3.0;
+    let lowest = heights.iter().flatten().flatten().copied().fold(f64::INFINITY, f64::min);
+    let mut hem = Vec::new();
+    for (p, edges) in heights.iter().enumerate() {
+        for (e, ends) in edges.iter().enumerate() {
+            if !stitched[p].contains(&e) && ends.iter().all(|&z| z < lowest + HEM_BAND) {
+                hem.push(format!("{}.{}", order[p], panels[p].edges[e].name));
+            }
+        }
+    }
+    hem
 }
 
 /// The largest relative difference between a seam's sides that an import sets
@@ -358,51 +363,7 @@ fn convert_panel(name: &str, panel: &SpecPanel, relative: bool, to_cm: f64, grai
     let mut edge_heights = Vec::with_capacity(n);
     for (i, e) in panel.edges.iter().enumerate() {
         let (start, end) = (vertex(e.endpoints[0]), vertex(e.endpoints[1]));
-        let point = |p: [f64; 2]| -> DVec2 {
-            let p = DVec2::from_array(p);
-            if relative {
-                let chord = end - start;
-                start + p.x * chord + p.y * chord.perp()
-            } else {
-                p
-            }
-        };
-        let key = |m: &str| at(format!("edge {i}: {m}"));
-        let (mut through, mut controls) = (None, None);
-        match &e.curvature {
-            None | Some(Value::Null) => {}
-            Some(c) => {
-                let kind = if c.is_array() { "quadratic" } else { c.get("type").and_then(Value::as_str).ok_or_else(|| key("curvature has no \"type\""))? };
-                let params = if c.is_array() { Value::Array(vec![c.clone()]) } else { c.get("params").cloned().unwrap_or(Value::Null) };
-                let pair = |v: &Value| -> Result<[f64; 2], String> {
-                    let p: [f64; 2] = serde_json::from_value(v.clone()).map_err(|_| key("a control point must be two numbers"))?;
-                    if p.iter().all(|x| x.is_finite()) { Ok(p) } else { Err(key("a control point is not finite")) }
-                };
-                let list = params.as_array().cloned().unwrap_or_default();
-                match kind {
-                    "quadratic" => {
-                        let q = point(pair(list.first().ok_or_else(|| key("a quadratic curve needs one control point"))?)?);
-                        // The same curve as a cubic: control points two thirds of the way to q.
-                        controls = Some([start + (q - start) * (2.0 / 3.0), end + (q - end) * (2.0 / 3.0)]);
-                    }
-                    "cubic" => {
-                        if list.len() != 2 {
-                            return Err(key("a cubic curve needs two control points"));
-                        }
-                        controls = Some([point(pair(&list[0])?), point(pair(&list[1])?)]);
-                    }
-                    "circle" => {
-                        let radius = list.first().and_then(Value::as_f64).filter(|r| r.is_finite() && *r > 0.0).ok_or_else(|| key("a circle needs a positive radius"))?;
-                        let flag = |j: usize| list.get(j).and_then(|v| v.as_bool().or_else(|| v.as_f64().map(|x| x != 0.0)));
-                        let (Some(large), Some(right)) = (flag(1), flag(2)) else {
-                            return Err(key("a circle's params are [radius, large_arc, right]"));
-                        };
-                        through = Some(arc_midpoint(start, end, radius, large, right).ok_or_else(|| key(&format!("radius {radius} is shorter than half the edge's chord")))?);
-                    }
-                    other => return Err(key(&format!("unknown curvature type \"{other}\" (quadratic, cubic or circle)"))),
-                }
-            }
-        }
+        let (through, controls) = edge_curve(e.curvature.as_ref(), start, end, relative).map_err(|m| at(format!("edge {i}: {m}")))?;
         edges.push(EdgeConfig {
             name: format!("e{i}"),
             to: plane(end).to_array(),
@@ -421,6 +382,60 @@ fn convert_panel(name: &str, panel: &SpecPanel, relative: bool, to_cm: f64, grai
         placement,
     };
     Ok((panel, edge_heights))
+}
+
+/// An edge's curve: the middle point of an arc, or the two control points of a cubic
+/// Bézier; neither for a straight edge.
+type Curve = (Option<DVec2>, Option<[DVec2; 2]>);
+
+/// The curve of an edge from `start` to `end` (panel coordinates) with GarmentCode's
+/// `curvature`, a quadratic raised to degree three (the same curve).
+fn edge_curve(curvature: Option<&Value>, start: DVec2, end: DVec2, relative: bool) -> Result<Curve, String> {
+    let point = |p: [f64; 2]| -> DVec2 {
+        let p = DVec2::from_array(p);
+        if relative {
+            let chord = end - start;
+            start + p.x * chord + p.y * chord.perp()
+        } else {
+            p
+        }
+    };
+    let (mut through, mut controls) = (None, None);
+    match curvature {
+        None | Some(Value::Null) => {}
+        Some(c) => {
+            let kind = if c.is_array() { "quadratic" } else { c.get("type").and_then(Value::as_str).ok_or_else(|| "curvature has no \"type\"".to_string())? };
+            let params = if c.is_array() { Value::Array(vec![c.clone()]) } else { c.get("params").cloned().unwrap_or(Value::Null) };
+            let pair = |v: &Value| -> Result<[f64; 2], String> {
+                let p: [f64; 2] = serde_json::from_value(v.clone()).map_err(|_| "a control point must be two numbers".to_string())?;
+                if p.iter().all(|x| x.is_finite()) { Ok(p) } else { Err("a control point is not finite".to_string()) }
+            };
+            let list = params.as_array().cloned().unwrap_or_default();
+            match kind {
+                "quadratic" => {
+                    let q = point(pair(list.first().ok_or_else(|| "a quadratic curve needs one control point".to_string())?)?);
+                    // The same curve as a cubic: control points two thirds of the way to q.
+                    controls = Some([start + (q - start) * (2.0 / 3.0), end + (q - end) * (2.0 / 3.0)]);
+                }
+                "cubic" => {
+                    if list.len() != 2 {
+                        return Err("a cubic curve needs two control points".to_string());
+                    }
+                    controls = Some([point(pair(&list[0])?), point(pair(&list[1])?)]);
+                }
+                "circle" => {
+                    let radius = list.first().and_then(Value::as_f64).filter(|r| r.is_finite() && *r > 0.0).ok_or_else(|| "a circle needs a positive radius".to_string())?;
+                    let flag = |j: usize| list.get(j).and_then(|v| v.as_bool().or_else(|| v.as_f64().map(|x| x != 0.0)));
+                    let (Some(large), Some(right)) = (flag(1), flag(2)) else {
+                        return Err("a circle's params are [radius, large_arc, right]".to_string());
+                    };
+                    through = Some(arc_midpoint(start, end, radius, large, right).ok_or_else(|| format!("radius {radius} is shorter than half the edge's chord"))?);
+                }
+                other => return Err(format!("unknown curvature type \"{other}\" (quadratic, cubic or circle)")),
+            }
+        }
+    }
+    Ok((through, controls))
 }
 
 /// The middle of the circular arc of `radius` from `start` to `end`: the short or long
