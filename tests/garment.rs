@@ -48,6 +48,14 @@ fn bad_patterns_are_refused_naming_the_panel_and_the_edge() {
     let config = load_text("inside", &inside).unwrap();
     let err = Scene::build(config).err().expect("a panel inside the form is refused").to_string();
     assert!(err.contains("'front'") && err.contains("inside the form"), "{err}");
+    // An anchor typed in the wrong units (a panel placed 30 m to the side), and one at
+    // infinity: refused naming the panel and the keys to check.
+    for anchor in ["3000", "inf"] {
+        let far = gored.replacen("anchor = [0, 54.1131]", &format!("anchor = [{anchor}, 54.1131]"), 1);
+        assert_ne!(far, gored);
+        let err = load_text("far", &far).expect_err("a panel placed far off is refused");
+        assert!(err.contains("'front'") && err.contains("anchor") && err.contains("from the form's axis"), "{err}");
+    }
 }
 
 /// The gored skirt on a coarse mesh: every seam closes under the sewing springs to a

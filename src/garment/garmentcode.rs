@@ -210,6 +210,14 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
             Ok((p, edge))
         };
         let (a, b) = (side(0).map_err(bad)?, side(1).map_err(bad)?);
+        let edge = |(p, e): (usize, usize)| format!("panel '{}' edge {e}", order[p]);
+        if a == b {
+            return Err(bad(format!("pattern.stitches[{i}] joins {} to itself", edge(a))));
+        }
+        // GarmentCode stitches whole edges, so an edge in two stitches is sewn twice over.
+        if let Some((j, twice)) = sides.iter().enumerate().find_map(|(j, &(x, y))| [a, b].into_iter().find(|s| *s == x || *s == y).map(|s| (j, s))) {
+            return Err(bad(format!("pattern.stitches[{j}] and pattern.stitches[{i}] both sew {}: an edge takes one stitch", edge(twice))));
+        }
         let direction = match stitch.get(2).and_then(Value::as_str) {
             Some("right_wrong") => Direction::Same,
             _ => Direction::Opposite,
@@ -305,6 +313,15 @@ fn convert_panel(name: &str, panel: &SpecPanel, relative: bool, to_cm: f64, grai
     let finite = panel.translation.iter().chain(&panel.rotation).chain(panel.vertices.iter().flatten()).all(|v| v.is_finite());
     if !finite {
         return Err(at("a translation, rotation or vertex value is not a finite number".into()));
+    }
+    // Beyond 10 m a value is a unit slip, and the outline's area would overflow.
+    const MAX_CM: f64 = 1000.0;
+    if let Some(k) = panel.vertices.iter().position(|v| v.iter().any(|x| (x * to_cm).abs() > MAX_CM)) {
+        let [x, y] = panel.vertices[k];
+        return Err(at(format!("vertex {k} at ({x}, {y}) lies more than {MAX_CM} cm from the panel's origin; check properties.units_in_meter")));
+    }
+    if panel.translation.iter().any(|x| (x * to_cm).abs() > MAX_CM) {
+        return Err(at(format!("its translation {:?} places it more than {MAX_CM} cm from the body; check properties.units_in_meter", panel.translation)));
     }
     let n = panel.edges.len();
     if n < 2 {
@@ -581,6 +598,15 @@ mod tests {
         let gathered = SPEC.replacen(r#""stitches": ["#, r#""stitches": [[{"panel": "front", "edge": 0}, {"panel": "sleeve", "edge": 1}], "#, 1);
         let e = import(&gathered, "x.json", &options()).err().unwrap().message;
         assert!(e.contains("stitches[0]") && e.contains("front.e0 (40.0 cm)") && e.contains("sleeve.e1 (10.0 cm)") && e.contains("75 %"), "{e}");
+        let twice = SPEC.replacen(r#""stitches": ["#, r#""stitches": [[{"panel": "front", "edge": 0}, {"panel": "back", "edge": 3}], "#, 1);
+        let e = import(&twice, "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("stitches[0] and pattern.stitches[1]") && e.contains("panel 'back' edge 3"), "{e}");
+        let itself = SPEC.replacen(r#"{"panel": "back", "edge": 3}"#, r#"{"panel": "front", "edge": 1}"#, 1);
+        let e = import(&itself, "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("stitches[0] joins panel 'front' edge 1 to itself"), "{e}");
+        let huge = SPEC.replacen("[40, 0]", "[1e300, 0]", 1);
+        let e = import(&huge, "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("panel 'front'") && e.contains("vertex 1") && e.contains("units_in_meter"), "{e}");
         assert!(import("{", "x.json", &options()).is_err());
     }
 }

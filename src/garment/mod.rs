@@ -186,7 +186,9 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
         };
         check_placement(panel, config.units)?;
         let place = place::Placement::new(&panel.placement, anchor, axis, metres);
+        let start = positions.len();
         positions.extend(m.points.iter().map(|&p| place.position(p)));
+        check_reach(panel, config.units, &positions[start..], axis)?;
     }
     let seams = seam_pairs(&sides, &cuts, &meshes, &offsets, config);
     let seam_lengths = sides.iter().map(|(a, b)| (a.to - a.from, b.to - b.from)).collect();
@@ -252,6 +254,29 @@ fn check_placement(panel: &PanelConfig, units: Units) -> Result<(), GarmentError
         )));
     }
     Ok(())
+}
+
+/// How far from the form's axis, and above or below its floor point, a placed panel may
+/// start, m. A designer arranges panels around the body; a panel metres away (an anchor or
+/// distance typed in the wrong units) would fall for seconds before its seams could close.
+const MAX_REACH: f64 = 5.0;
+
+/// Refuses a panel whose placed points (m) are not finite or lie beyond [`MAX_REACH`].
+fn check_reach(panel: &PanelConfig, units: Units, placed: &[DVec3], axis: DVec2) -> Result<(), GarmentError> {
+    let reach = placed.iter().map(|p| (p.truncate() - axis).length().max(p.z.abs())).fold(0.0, f64::max);
+    if placed.iter().all(|p| p.is_finite()) && reach <= MAX_REACH {
+        return Ok(());
+    }
+    let shown = match reach {
+        r if r < 1e4 => format!("{r:.2} m"),
+        r if r.is_finite() => format!("{r:.2e} m"),
+        _ => "at infinity".into(),
+    };
+    Err(GarmentError::new(format!(
+        "garment.panels '{}': placed, its farthest point lies {shown} from the form's axis or floor (at most {MAX_REACH} m); check its anchor and placement (distance, height), in {}",
+        panel.name,
+        units.name()
+    )))
 }
 
 /// Every seam's two sides, and the number of parts each seam is cut into.
