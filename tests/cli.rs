@@ -220,9 +220,11 @@ fn runs_swing() {
 /// The garments on 5 cm edges for 1.5 s, past their sewing time (the bundled meshes run in
 /// tests/garment.rs and take a minute each). Every bundled garment is sewn (exit 0, its
 /// metrics saying so), never deeper into the form than its contact layer and free of
-/// self-intersection. A garment whose sewing time ends before its seams can close (0.2 s
-/// into a 0.5 s sewing schedule, its seams still more than half as far apart as they
-/// started) exits 8 naming garment.sewing_time, its metrics written with `sewn` false.
+/// self-intersection. A garment whose sewing time ends before its seams can close (springs
+/// of 0.01 N/m, 5 000 times weaker than the default, for 0.2 s: its seams still centimetres
+/// open; a sewing ramp not shorter than the sewing time is refused before the run, in
+/// tests/garment.rs) exits 8 naming garment.sewing_time, its metrics written with `sewn`
+/// false.
 #[test]
 fn runs_garments() {
     // Both paths: the fast one takes the garment step and its contact penalty.
@@ -245,7 +247,7 @@ fn runs_garments() {
         assert_eq!(metrics["self_intersections"].as_u64(), Some(0), "{name}");
     }
     let path = metrics_path("unsewn");
-    let out = rosette(&["run", "skirt-gored-straight", "--set", "mesh.edge_length=0.05", "--set", "garment.sewing_time=0.2", "--duration", "0.3", "--metrics", path.to_str().unwrap()]);
+    let out = rosette(&["run", "skirt-gored-straight", "--set", "mesh.edge_length=0.05", "--set", "garment.sewing_time=0.2", "--set", "garment.sewing_ramp=0.15", "--set", "garment.sewing_stiffness=0.01", "--duration", "0.3", "--metrics", path.to_str().unwrap()]);
     let written = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("unsewn: no metrics ({e}): {}", text(&out.stderr)));
     std::fs::remove_file(&path).ok();
     assert_eq!(out.status.code(), Some(8), "{}", text(&out.stderr));

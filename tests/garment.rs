@@ -56,6 +56,22 @@ fn bad_patterns_are_refused_naming_the_panel_and_the_edge() {
         let err = load_text("far", &far).expect_err("a panel placed far off is refused");
         assert!(err.contains("'front'") && err.contains("anchor") && err.contains("from the form's axis"), "{err}");
     }
+    // Each refused naming its key, before any step: a panel below the floor, lengths in cm
+    // read as metres, a seam from an edge to itself, a weld 20 cm wide (it once took a
+    // step of minutes), and springs that cannot draw the seams shut by the sewing time.
+    let cases = [
+        ("height = 104 }", "height = -50 }", &["'front'", "positive distance and height"][..]),
+        ("units = \"cm\"", "units = \"m\"", &["check garment.units", "m across"]),
+        ("b = \"right.left\"", "b = \"front.right\"", &["garment.seams[0] sews edge 'right' of panel 'front' to itself"]),
+        ("units = \"cm\"", "units = \"cm\"\nclosed_share = 100", &["garment.closed_share = 100 is more than 1"]),
+        ("units = \"cm\"", "units = \"cm\"\nsewing_ramp = 2", &["garment.sewing_ramp = 2 s is not shorter than garment.sewing_time"]),
+    ];
+    for (from, to, words) in cases {
+        let bad = gored.replacen(from, to, 1);
+        assert_ne!(bad, gored, "{from}");
+        let err = load_text("bad", &bad).expect_err(to);
+        assert!(words.iter().all(|w| err.contains(w)), "{to}: {err}");
+    }
 }
 
 /// The gored skirt on a coarse mesh: every seam closes under the sewing springs to a

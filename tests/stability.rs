@@ -84,3 +84,24 @@ fn explicit_drape_above_its_limit_is_caught_not_swept() {
     assert!(metrics.steps < 20 && !metrics.stable, "{} steps", metrics.steps);
     assert!(message.contains("symplectic-euler") && message.contains("stable here only below"), "{message}");
 }
+
+/// `--max-wall` holds within a step: past the scene's deadline Newton starts no further
+/// iteration, so a step that one pathological scene would spend minutes on ends at once,
+/// reported unconverged (never passed off as converged), and the run stops at its bound.
+#[test]
+fn a_wall_time_bound_stops_newton_within_the_step() {
+    use rosette::scene::{RunOptions, Scene, load_scene, run_scene};
+    let (config, _) = load_scene("sphere-drop", &["mesh.edge_length=0.05".to_string()]).unwrap();
+    let mut scene = Scene::build(config.clone()).unwrap();
+    let report = scene.step().unwrap();
+    assert!(!report.newton_unconverged && report.newton_iterations > 0, "the first step converges without a bound");
+    let mut bounded = Scene::build(config).unwrap();
+    bounded.deadline = Some(std::time::Instant::now());
+    let report = bounded.step().unwrap();
+    assert!(report.newton_unconverged && report.newton_iterations == 0, "{report:?}");
+    // Through the run: the bound's deadline is the scene's while it runs, and cleared after.
+    let mut run = Scene::build(scene.config.clone()).unwrap();
+    let (metrics, _) = run_scene(&mut run, "bounded", RunOptions { max_wall_seconds: Some(1e-3), ..Default::default() });
+    assert!(metrics.stopped_at_limit.is_some() && metrics.steps <= 2, "{:?} after {} steps", metrics.stopped_at_limit, metrics.steps);
+    assert!(run.deadline.is_none());
+}

@@ -49,7 +49,8 @@ pub enum Command {
         /// scene that needs more is refused before it starts.
         #[arg(long, value_name = "N")]
         max_steps: Option<u64>,
-        /// Wall-clock seconds after which the run stops, keeping what it has (exit 6).
+        /// Wall-clock seconds after which the run stops, keeping what it has (exit 6); a step
+        /// in progress stops at its next Newton iteration, counted unconverged.
         #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_MAX_WALL, allow_hyphen_values = true)]
         max_wall: f64,
         /// Take the fast path (solver.path = "fast"): settling scenes settle coarse to fine,

@@ -314,6 +314,9 @@ fn convert_panel(name: &str, panel: &SpecPanel, relative: bool, to_cm: f64, grai
     if !finite {
         return Err(at("a translation, rotation or vertex value is not a finite number".into()));
     }
+    if panel.rotation.iter().any(|r| r.abs() > 360.0) {
+        return Err(at(format!("its rotation {:?} must be angles in degrees between -360 and 360", panel.rotation)));
+    }
     // Beyond 10 m a value is a unit slip, and the outline's area would overflow.
     const MAX_CM: f64 = 1000.0;
     if let Some(k) = panel.vertices.iter().position(|v| v.iter().any(|x| (x * to_cm).abs() > MAX_CM)) {
@@ -446,7 +449,13 @@ fn edge_curve(curvature: Option<&Value>, start: DVec2, end: DVec2, relative: boo
                     let (Some(large), Some(right)) = (flag(1), flag(2)) else {
                         return Err("a circle's params are [radius, large_arc, right]".to_string());
                     };
-                    through = Some(arc_midpoint(start, end, radius, large, right).ok_or_else(|| format!("radius {radius} is shorter than half the edge's chord"))?);
+                    let middle = arc_midpoint(start, end, radius, large, right).ok_or_else(|| format!("radius {} is shorter than half the edge's chord", crate::io::number::short(radius)))?;
+                    let chord = start.distance(end);
+                    if !(middle.is_finite() && middle.distance(0.5 * (start + end)) <= 1e3 * chord) {
+                        return Err(format!("radius {} makes the large arc over a {chord:.3} chord bulge beyond a thousand chords", crate::io::number::short(radius)));
+                    }
+                    // An arc too flat to tell from its chord is drawn straight.
+                    through = (middle.distance(0.5 * (start + end)) > 1e-9 * chord).then_some(middle);
                 }
                 other => return Err(format!("unknown curvature type \"{other}\" (quadratic, cubic or circle)")),
             }
@@ -466,8 +475,9 @@ fn arc_midpoint(start: DVec2, end: DVec2, radius: f64, large: bool, right: bool)
     if radius < half * (1.0 - 1e-6) || half == 0.0 {
         return None;
     }
-    let rise = (radius * radius - half * half).max(0.0).sqrt();
-    let sagitta = if large { radius + rise } else { radius - rise };
+    // Written so that no square overflows: a radius of 1e300 is a straight edge.
+    let rise = radius * (1.0 - (half / radius).powi(2)).max(0.0).sqrt();
+    let sagitta = if large { radius + rise } else { half * half / (radius + rise) };
     let normal = DVec2::new(chord.y, -chord.x) / chord.length();
     Some(0.5 * (start + end) + sagitta * if right { normal } else { -normal })
 }
@@ -604,6 +614,13 @@ mod tests {
         let itself = SPEC.replacen(r#"{"panel": "back", "edge": 3}"#, r#"{"panel": "front", "edge": 1}"#, 1);
         let e = import(&itself, "x.json", &options()).err().unwrap().message;
         assert!(e.contains("stitches[0] joins panel 'front' edge 1 to itself"), "{e}");
+        let flat = SPEC.replace(r#""params": [12, 0, 1]"#, r#""params": [1e300, 0, 1]"#);
+        let sleeve = import(&flat, "x.json", &options()).unwrap().garment.panels.into_iter().find(|p| p.name == "sleeve").unwrap();
+        assert!(sleeve.edges[2].through.is_none(), "an arc of radius 1e300 is its chord");
+        let e = import(&SPEC.replace(r#""params": [12, 0, 1]"#, r#""params": [1e300, 1, 1]"#), "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("panel 'sleeve'") && e.contains("edge 2") && e.contains("radius 1e300"), "{e}");
+        let e = import(&SPEC.replace("[0, 0, -50]", "[0, 0, 1e300]"), "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("panel 'sleeve'") && e.contains("between -360 and 360"), "{e}");
         let huge = SPEC.replacen("[40, 0]", "[1e300, 0]", 1);
         let e = import(&huge, "x.json", &options()).err().unwrap().message;
         assert!(e.contains("panel 'front'") && e.contains("vertex 1") && e.contains("units_in_meter"), "{e}");

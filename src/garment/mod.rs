@@ -143,10 +143,25 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
     check_names(&names)?;
     let mut curves: Vec<Vec<Polyline>> = Vec::with_capacity(config.panels.len());
     for panel in &config.panels {
-        if !panel.grain_deg.is_finite() {
-            return Err(GarmentError::new(format!("garment.panels '{}': grain_deg = {} must be a finite angle in degrees", panel.name, panel.grain_deg)));
+        if !(panel.grain_deg.is_finite() && panel.grain_deg.abs() <= 360.0) {
+            return Err(GarmentError::new(format!(
+                "garment.panels '{}': grain_deg = {} must be a finite angle in degrees, between -360 and 360",
+                panel.name, panel.grain_deg
+            )));
         }
         let c = panel.curves(metres)?;
+        // A panel wider than the reach on both sides of the form is a unit slip (cm numbers
+        // read as m); caught here, before the mesh's size is judged by it.
+        let (lo, hi) = c.iter().flat_map(|e| &e.points).fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let across = (hi - lo).max_element();
+        if across > 2.0 * MAX_REACH {
+            return Err(GarmentError::new(format!(
+                "garment.panels '{}' is {across:.1} m across, more than a garment's {} m; check garment.units (now {})",
+                panel.name,
+                2.0 * MAX_REACH,
+                config.units.name()
+            )));
+        }
         let edge_names: Vec<&str> = panel.edges.iter().map(|e| e.name.as_str()).collect();
         pattern::check_simple(&panel.name, &edge_names, &c)?;
         curves.push(c);
@@ -208,7 +223,13 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
                 })?;
                 attached_edges.push((vertices, z));
             }
-            (false, None, Some(h)) if h.is_finite() => attached_edges.push((vertices, h * metres)),
+            (false, None, Some(h)) if h.is_finite() && h > 0.0 && h * metres <= MAX_REACH => attached_edges.push((vertices, h * metres)),
+            (false, None, Some(h)) if h.is_finite() => {
+                return Err(GarmentError::new(format!(
+                    "garment.attachments[{i}].height = {h} {} is not on the form: give a height above the floor, at most {MAX_REACH} m",
+                    config.units.name()
+                )));
+            }
             _ => return Err(GarmentError::new(format!("garment.attachments[{i}]: give exactly one of pin = true, level or height (finite)"))),
         }
     }
@@ -246,9 +267,9 @@ fn check_names(names: &[(String, Vec<String>)]) -> Result<(), GarmentError> {
 fn check_placement(panel: &PanelConfig, units: Units) -> Result<(), GarmentError> {
     let p = &panel.placement;
     let finite = [p.angle_deg, p.distance, p.height, p.flare_deg].iter().all(|v| v.is_finite());
-    if !finite || p.distance <= 0.0 || !(0.0..=90.0).contains(&p.flare_deg) {
+    if !finite || p.distance <= 0.0 || p.height <= 0.0 || p.angle_deg.abs() > 360.0 || !(0.0..=90.0).contains(&p.flare_deg) {
         return Err(GarmentError::new(format!(
-            "garment.panels '{}': placement needs a finite angle_deg, a positive distance and height in {} and flare_deg between 0 and 90",
+            "garment.panels '{}': placement needs angle_deg between -360 and 360, a positive distance and height (above the floor) in {} and flare_deg between 0 and 90",
             panel.name,
             units.name()
         )));
@@ -263,14 +284,17 @@ const MAX_REACH: f64 = 5.0;
 
 /// Refuses a panel whose placed points (m) are not finite or lie beyond [`MAX_REACH`].
 fn check_reach(panel: &PanelConfig, units: Units, placed: &[DVec3], axis: DVec2) -> Result<(), GarmentError> {
-    let reach = placed.iter().map(|p| (p.truncate() - axis).length().max(p.z.abs())).fold(0.0, f64::max);
-    if placed.iter().all(|p| p.is_finite()) && reach <= MAX_REACH {
+    if !axis.is_finite() {
+        return Err(GarmentError::new(format!("garment.form.axis = {:?} must be two finite coordinates in {}", axis.to_array(), units.name())));
+    }
+    let reach = placed.iter().map(|p| (p.truncate() - axis).length().max(p.z.abs())).fold(0.0, |r: f64, d| if d.is_nan() { f64::INFINITY } else { r.max(d) });
+    if reach <= MAX_REACH {
         return Ok(());
     }
     let shown = match reach {
         r if r < 1e4 => format!("{r:.2} m"),
         r if r.is_finite() => format!("{r:.2e} m"),
-        _ => "at infinity".into(),
+        _ => "at no finite position (a value is not a number)".into(),
     };
     Err(GarmentError::new(format!(
         "garment.panels '{}': placed, its farthest point lies {shown} from the form's axis or floor (at most {MAX_REACH} m); check its anchor and placement (distance, height), in {}",

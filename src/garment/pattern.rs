@@ -149,7 +149,7 @@ fn point(panel: &str, key: &str, p: [f64; 2], metres: f64) -> Result<DVec2, Garm
     if p.iter().all(|c| c.is_finite() && c.abs() < 1e5) {
         Ok(DVec2::from_array(p) * metres)
     } else {
-        Err(GarmentError::new(format!("garment.panels '{panel}': {key} = {p:?} must be two finite coordinates")))
+        Err(GarmentError::new(format!("garment.panels '{panel}': {key} = {p:?} must be two finite coordinates under 100 000 in size")))
     }
 }
 

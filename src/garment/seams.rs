@@ -102,23 +102,26 @@ pub fn cuts(lengths: &[Vec<f64>], seams: &[(Side, Side)], counts: &[usize], edge
         let mut panel_cuts = Vec::with_capacity(edges.len());
         for (e, &length) in edges.iter().enumerate() {
             // The seam stretches on this edge, in order along it.
-            let mut stretches: Vec<(f64, f64, usize)> = seams
+            let mut stretches: Vec<(f64, f64, usize, usize)> = seams
                 .iter()
                 .zip(counts)
-                .flat_map(|((a, b), &n)| [(a, n), (b, n)])
-                .filter(|(s, _)| s.panel == p && s.edge == e)
-                .map(|(s, n)| (s.from, s.to, n))
+                .enumerate()
+                .flat_map(|(i, ((a, b), &n))| [(a, n, i), (b, n, i)])
+                .filter(|(s, _, _)| s.panel == p && s.edge == e)
+                .map(|(s, n, i)| (s.from, s.to, n, i))
                 .collect();
             stretches.sort_by(|x, y| x.0.total_cmp(&y.0));
             let mut cut = vec![0.0];
             let mut at = 0.0;
-            for (from, to, n) in stretches {
-                if from < at - 1e-9 {
-                    return Err(GarmentError::new(format!(
-                        "garment.seams: two seams overlap on edge '{}' of panel '{}'; give each its own stretch with a_span / b_span",
-                        names[p].1[e], names[p].0
-                    )));
+            let mut last = None;
+            for (from, to, n, i) in stretches {
+                if let (true, Some(j)) = (from < at - 1e-9, last) {
+                    let which = if i == j { format!("garment.seams[{i}] sews edge '{}' of panel '{}' to itself", names[p].1[e], names[p].0) } else {
+                        format!("garment.seams[{}] and garment.seams[{}] overlap on edge '{}' of panel '{}'", i.min(j), i.max(j), names[p].1[e], names[p].0)
+                    };
+                    return Err(GarmentError::new(format!("{which}; give each side its own stretch with a_span / b_span")));
                 }
+                last = Some(i);
                 if from > at + 1e-9 {
                     cut.extend(even_cuts(at, from - at, parts(from - at)).into_iter().skip(1));
                 }

@@ -54,6 +54,9 @@ pub struct Scene {
     level_edge: Option<f64>,
     /// A garment's sewing (None for other scenes).
     pub garment: Option<garment::Sewing>,
+    /// Wall-clock time past which no step starts another Newton iteration
+    /// (`Integrator::deadline`, set from `--max-wall`); None: no bound.
+    pub deadline: Option<std::time::Instant>,
 }
 
 
@@ -96,7 +99,7 @@ impl Scene {
             let rig = Rig::Garment(Box::new(parts.rig));
             let (state, model, props) = (State::at_rest(parts.x), parts.model, parts.props);
             let sample_every = (steps / 400).max(1);
-            return Ok(Self { state, config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: Some(parts.sewing) });
+            return Ok(Self { state, config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: Some(parts.sewing), deadline: None });
         }
         let c = &level_config.cloth;
         let warp = c.warp_angle_deg.to_radians();
@@ -133,7 +136,7 @@ impl Scene {
         let integrator = level_config.solver.integrator();
         let steps = (config.scene.duration / level_config.solver.dt).ceil().max(1.0) as u64;
         let sample_every = (steps / 400).max(1);
-        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: None })
+        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: None, deadline: None })
     }
 
     /// Changes the time step (s) and integrator, keeping positions, velocities, time and
@@ -183,6 +186,8 @@ impl Scene {
             self.model.options.gravity = DVec3::new(0.0, 0.0, -STANDARD_GRAVITY * (t / ramp).min(1.0));
         }
         self.sew_before_step();
+        // The integrator may have been replaced (a finer level, a welded garment).
+        self.integrator.deadline = self.deadline;
         let report = self.integrator.step(&self.model, &mut self.state)?;
         self.sew_after_step();
         if self.state.steps.is_multiple_of(self.sample_every) {

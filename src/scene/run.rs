@@ -270,6 +270,9 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
     let mut k = 0u64;
     let mut stopped_at_limit = None;
     let max_steps = options.max_steps.unwrap_or(scene.config.scene.max_steps);
+    // The bound holds within a step too: past it Newton starts no further iteration.
+    let before = scene.deadline;
+    scene.deadline = options.max_wall_seconds.and_then(|limit| std::time::Duration::try_from_secs_f64(limit).ok()).and_then(|limit| wall.checked_add(limit));
     // Steps until the end time is reached (a fixed Δt that does not divide the duration
     // ends past it).
     while scene.state.time < end_time - 1e-6 * scene.integrator.dt {
@@ -304,6 +307,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             p(((scene.state.time - start_time) / duration).min(1.0));
         }
     }
+    scene.deadline = before;
     let cpu_seconds = cpu.elapsed().as_secs_f64();
     let simulated = scene.state.time - start_time;
     let per_second = if simulated > 0.0 { cpu_seconds / simulated } else { 0.0 };

@@ -24,8 +24,31 @@ pub fn check(c: &SceneConfig) -> Result<f64, Invalid> {
     positive_at_most("garment.sewing_stiffness", g.sewing_stiffness, MAX_SEWING_STIFFNESS, "a sewing spring's stiffness in N/m; the default is 50")?;
     positive("garment.sewing_ramp", g.sewing_ramp)?;
     positive("garment.sewing_time", g.sewing_time)?;
-    positive("garment.closed_share", g.closed_share)?;
+    positive_at_most(
+        "garment.closed_share",
+        g.closed_share,
+        1.0,
+        "a seam is welded once its sides are within this share of the contact layer; farther apart they would be welded out of shape; the default is 0.25",
+    )?;
     non_negative("garment.sewing_damping", g.sewing_damping)?;
+    if !g.seams.is_empty() && g.sewing_ramp >= g.sewing_time {
+        return Err(invalid(
+            "garment.sewing_ramp",
+            format!(
+                "garment.sewing_ramp = {} s is not shorter than garment.sewing_time = {} s: the seams close only once the ramp has drawn them together; shorten the ramp or lengthen the sewing time",
+                g.sewing_ramp, g.sewing_time
+            ),
+        ));
+    }
+    if let Some(scale) = g.form.scale {
+        if g.form.obj.is_none() {
+            return Err(invalid("garment.form.scale", "garment.form.scale scales an OBJ body (garment.form.obj); remove it, or give the obj".into()));
+        }
+        positive_at_most("garment.form.scale", scale, 1e4, "the factor the OBJ body's coordinates are multiplied by")?;
+    }
+    if !g.form.axis.iter().all(|v| v.is_finite() && v.abs() * g.units.metres() <= 100.0) {
+        return Err(invalid("garment.form.axis", format!("garment.form.axis = {:?} must be two finite coordinates within 100 m, in {}", g.form.axis, g.units.name())));
+    }
     if g.sewing_time > c.scene.duration {
         return Err(invalid("garment.sewing_time", format!("garment.sewing_time = {} s is longer than scene.duration = {} s", g.sewing_time, c.scene.duration)));
     }

@@ -150,6 +150,10 @@ pub struct Integrator {
     quasi: Option<quasi_newton::StepMatrices>,
     /// The quasi-Newton step's iteration budget for the next step (`quasi_newton.rs`).
     quasi_budget: usize,
+    /// The wall-clock time past which Newton starts no further iteration, leaving its step
+    /// unconverged (and counted so), so that a run's wall-time bound holds within a step
+    /// however long one iteration of a pathological scene takes. None: no bound.
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Integrator {
@@ -173,6 +177,7 @@ impl Integrator {
             last_step_error: f64::INFINITY,
             quasi: None,
             quasi_budget: usize::MAX,
+            deadline: None,
         }
     }
 

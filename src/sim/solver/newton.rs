@@ -160,6 +160,9 @@ impl Integrator {
         let mut watch = Stopwatch::start();
         report.newton_unconverged = true;
         for _ in 0..self.newton.max_iterations {
+            if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                break;
+            }
             problem.update_tolerance(y);
             let norm = self.gradient(&problem, y, &mut work.gradient, &mut watch);
             work.rhs = work.gradient.iter().map(|g| -*g).collect();
