@@ -115,6 +115,12 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
         }
         _ => {}
     }
+    if let (Some(n @ 1..), true) = (metrics.self_intersections, config.contact.self_collision) {
+        metrics.notes.push(format!(
+            "the cloth ends passing through itself in {n} places though contact.self_collision is on: the folds there are not physical{}",
+            if scene.garment.is_some() { "; panels that start through each other (GarmentCode's arrangement can place them so) may stay tangled: check their placement" } else { "" }
+        ));
+    }
     let end = scene.state.time;
     // The time is a sum of steps: a run to a motion's end may fall short of it by round-off.
     let unfinished = !scene.model.motions_finished(end * (1.0 + 1e-9) + 1e-12);
