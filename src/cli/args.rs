@@ -28,7 +28,7 @@ pub enum Command {
     Run {
         /// A bundled scene name (see `rosette presets`) or the path of a scene file.
         preset: String,
-        /// Override a preset value, e.g. --set fabric.areal_density=0.2 (repeatable).
+        /// Override a preset value, e.g. --set fabric.areal_density=0.2, or a list's entry by index, e.g. --set garment.panels[1].grain_deg=45 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         overrides: Vec<String>,
         /// Simulated seconds (default: the scene's scene.duration).

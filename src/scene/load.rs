@@ -292,6 +292,21 @@ mod tests {
         }
     }
 
+    /// `--set` reaches one entry of a list: the bias skirt's second gore cut on the straight
+    /// grain, the others left alone; an entry past the list's end is refused with its count.
+    #[test]
+    fn an_override_reaches_one_entry_of_a_list() {
+        let (config, _) = load_scene("skirt-gored-bias", &["garment.panels[1].grain_deg=90".into()]).unwrap();
+        let (bundled, _) = load_scene("skirt-gored-bias", &[]).unwrap();
+        let grains = |c: &SceneConfig| c.garment.as_ref().unwrap().panels.iter().map(|p| p.grain_deg).collect::<Vec<_>>();
+        let (set, before) = (grains(&config), grains(&bundled));
+        assert_eq!(set[1], 90.0);
+        assert_ne!(before[1], 90.0);
+        assert_eq!((set[0], set[2], set[3]), (before[0], before[2], before[3]));
+        let e = load_scene("skirt-gored-bias", &["garment.panels[4].grain_deg=0".into()]).unwrap_err().to_string();
+        assert!(e.contains("has 4 entries") && e.contains("no [4]"), "{e}");
+    }
+
     #[test]
     fn overrides_parse_numbers_arrays_and_bare_strings() {
         let (config, _) = load_scene(

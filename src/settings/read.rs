@@ -166,15 +166,42 @@ pub fn parse_override(text: &str) -> Result<(Vec<String>, toml::Value), PresetEr
     Ok((path, parsed))
 }
 
+/// Sets `value` at the dotted `path` in `table`, creating tables on the way. A part written
+/// `name[i]` reaches entry i of the list `name` (`garment.panels[1].grain_deg=45`: the
+/// second `[[garment.panels]]`), which must exist.
 pub fn apply_override(table: &mut toml::Table, path: &[String], value: toml::Value) -> Result<(), String> {
     let (last, parents) = path.split_last().expect("non-empty key");
     let mut current = table;
     for part in parents {
-        let entry = current.entry(part.clone()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        current = entry.as_table_mut().ok_or_else(|| format!("'{part}' is a value, not a table"))?;
+        current = match indexed(part)? {
+            Some((name, i)) => entry_at(current, name, i)?.as_table_mut().ok_or_else(|| format!("'{part}' is a value, not a table"))?,
+            None => {
+                let entry = current.entry(part.clone()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
+                entry.as_table_mut().ok_or_else(|| format!("'{part}' is a value, not a table"))?
+            }
+        };
     }
-    current.insert(last.clone(), value);
+    match indexed(last)? {
+        Some((name, i)) => *entry_at(current, name, i)? = value,
+        None => {
+            current.insert(last.clone(), value);
+        }
+    }
     Ok(())
+}
+
+/// `name[i]` as (name, i); None for a plain key.
+fn indexed(part: &str) -> Result<Option<(&str, usize)>, String> {
+    let Some((name, rest)) = part.split_once('[') else { return Ok(None) };
+    let index = rest.strip_suffix(']').and_then(|i| i.trim().parse().ok()).filter(|_| !name.is_empty());
+    index.map(|i| Some((name, i))).ok_or_else(|| format!("'{part}': write a list's entry as name[index], counting from 0, e.g. panels[1]"))
+}
+
+/// Entry `i` of the list `name` in `table`.
+fn entry_at<'a>(table: &'a mut toml::Table, name: &str, i: usize) -> Result<&'a mut toml::Value, String> {
+    let list = table.get_mut(name).and_then(toml::Value::as_array_mut).ok_or_else(|| format!("'{name}' is not a list here, so '{name}[{i}]' names nothing"))?;
+    let count = list.len();
+    list.get_mut(i).ok_or_else(|| format!("'{name}' has {count} entries (0 to {}), no [{i}]", count.saturating_sub(1)))
 }
 
 /// The description line of every bundled scene, for `rosette presets`.
