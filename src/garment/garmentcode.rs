@@ -193,40 +193,11 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
         panels.push(panel);
         heights.push(edge_heights);
     }
-    let mut seams = Vec::with_capacity(spec.pattern.stitches.len());
-    // Each stitch's two sides as (panel, edge).
-    let mut sides = Vec::with_capacity(spec.pattern.stitches.len());
+    let (seams, sides) = stitches(&spec.pattern.stitches, &order, &panels).map_err(bad)?;
     let mut stitched = vec![Vec::new(); order.len()];
-    for (i, stitch) in spec.pattern.stitches.iter().enumerate() {
-        let side = |j: usize| -> Result<(usize, usize), String> {
-            let key = format!("pattern.stitches[{i}][{j}]");
-            let entry = stitch.get(j).ok_or_else(|| format!("{key} is missing: a stitch joins two edges"))?;
-            let panel = entry.get("panel").and_then(Value::as_str).ok_or_else(|| format!("{key} needs a \"panel\" name"))?;
-            let edge = entry.get("edge").and_then(Value::as_u64).ok_or_else(|| format!("{key} needs an \"edge\" index"))? as usize;
-            let p = order.iter().position(|n| n == panel).ok_or_else(|| format!("{key}: no panel '{panel}'"))?;
-            if edge >= panels[p].edges.len() {
-                return Err(format!("{key}: panel '{panel}' has {} edges, no edge {edge}", panels[p].edges.len()));
-            }
-            Ok((p, edge))
-        };
-        let (a, b) = (side(0).map_err(bad)?, side(1).map_err(bad)?);
-        let edge = |(p, e): (usize, usize)| format!("panel '{}' edge {e}", order[p]);
-        if a == b {
-            return Err(bad(format!("pattern.stitches[{i}] joins {} to itself", edge(a))));
-        }
-        // GarmentCode stitches whole edges, so an edge in two stitches is sewn twice over.
-        if let Some((j, twice)) = sides.iter().enumerate().find_map(|(j, &(x, y))| [a, b].into_iter().find(|s| *s == x || *s == y).map(|s| (j, s))) {
-            return Err(bad(format!("pattern.stitches[{j}] and pattern.stitches[{i}] both sew {}: an edge takes one stitch", edge(twice))));
-        }
-        let direction = match stitch.get(2).and_then(Value::as_str) {
-            Some("right_wrong") => Direction::Same,
-            _ => Direction::Opposite,
-        };
-        stitched[a.0].push(a.1);
-        stitched[b.0].push(b.1);
-        sides.push((a, b));
-        let key = |(p, e): (usize, usize)| format!("{}.{}", order[p], panels[p].edges[e].name);
-        seams.push(SeamConfig { a: key(a), b: key(b), direction, a_span: None, b_span: None });
+    for &((pa, ea), (pb, eb)) in &sides {
+        stitched[pa].push(ea);
+        stitched[pb].push(eb);
     }
     // GarmentCode gathers a seam whose sides differ (a bodice into a narrower skirt): the
     // ease is set to the pattern's largest difference, up to what Rosette sews.
@@ -274,6 +245,45 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
         closed_share: super::default_closed_share(),
     };
     Ok(Imported { garment, notes })
+}
+
+/// A stitch's two sides, each as (panel, edge) by index.
+type StitchSides = ((usize, usize), (usize, usize));
+
+/// GarmentCode's stitches as Rosette's seams, with each one's sides.
+fn stitches(stitches: &[Vec<Value>], order: &[String], panels: &[PanelConfig]) -> Result<(Vec<SeamConfig>, Vec<StitchSides>), String> {
+    let mut seams = Vec::with_capacity(stitches.len());
+    let mut sides: Vec<StitchSides> = Vec::with_capacity(stitches.len());
+    for (i, stitch) in stitches.iter().enumerate() {
+        let side = |j: usize| -> Result<(usize, usize), String> {
+            let key = format!("pattern.stitches[{i}][{j}]");
+            let entry = stitch.get(j).ok_or_else(|| format!("{key} is missing: a stitch joins two edges"))?;
+            let panel = entry.get("panel").and_then(Value::as_str).ok_or_else(|| format!("{key} needs a \"panel\" name"))?;
+            let edge = entry.get("edge").and_then(Value::as_u64).ok_or_else(|| format!("{key} needs an \"edge\" index"))? as usize;
+            let p = order.iter().position(|n| n == panel).ok_or_else(|| format!("{key}: no panel '{panel}'"))?;
+            if edge >= panels[p].edges.len() {
+                return Err(format!("{key}: panel '{panel}' has {} edges, no edge {edge}", panels[p].edges.len()));
+            }
+            Ok((p, edge))
+        };
+        let (a, b) = (side(0)?, side(1)?);
+        let edge = |(p, e): (usize, usize)| format!("panel '{}' edge {e}", order[p]);
+        if a == b {
+            return Err(format!("pattern.stitches[{i}] joins {} to itself", edge(a)));
+        }
+        // GarmentCode stitches whole edges, so an edge in two stitches is sewn twice over.
+        if let Some((j, twice)) = sides.iter().enumerate().find_map(|(j, &(x, y))| [a, b].into_iter().find(|s| *s == x || *s == y).map(|s| (j, s))) {
+            return Err(format!("pattern.stitches[{j}] and pattern.stitches[{i}] both sew {}: an edge takes one stitch", edge(twice)));
+        }
+        let direction = match stitch.get(2).and_then(Value::as_str) {
+            Some("right_wrong") => Direction::Same,
+            _ => Direction::Opposite,
+        };
+        sides.push((a, b));
+        let key = |(p, e): (usize, usize)| format!("{}.{}", order[p], panels[p].edges[e].name);
+        seams.push(SeamConfig { a: key(a), b: key(b), direction, a_span: None, b_span: None });
+    }
+    Ok((seams, sides))
 }
 
 /// The hem: the free edges (in no stitch) at the garment's bottom, both ends (`heights`,
