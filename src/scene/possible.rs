@@ -118,7 +118,12 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
     if let (Some(n @ 1..), true) = (metrics.self_intersections, config.contact.self_collision) {
         metrics.notes.push(format!(
             "the cloth ends passing through itself in {n} places though contact.self_collision is on: the folds there are not physical{}",
-            if scene.garment.is_some() { "; panels that start through each other (GarmentCode's arrangement can place them so) may stay tangled: check their placement" } else { "" }
+            if scene.garment.is_some() {
+                "; a garment is sewn with self-collision off (a seam's two sides must meet), so a panel its seams pull across \
+                 another can pass through it: place the panels so that none lies between two it is sewn to"
+            } else {
+                ""
+            }
         ));
     }
     let end = scene.state.time;
@@ -139,6 +144,32 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A garment's metrics after one step, with `count` crossings put in their place (a
+    /// real crossing needs a long run; `a_crossed_arrangement_is_refused_before_the_run`
+    /// covers the start) and the notes judged again.
+    fn notes_with_crossings(self_collision: bool, count: usize) -> Vec<String> {
+        let overrides = ["mesh.edge_length=0.05".to_string(), format!("contact.self_collision={self_collision}")];
+        let (config, _) = crate::scene::load_scene("skirt-gored-straight", &overrides).unwrap();
+        let mut scene = Scene::build(config).unwrap();
+        let (mut metrics, _) = crate::scene::run_scene(&mut scene, "crossed", crate::scene::RunOptions { duration: Some(0.004), ..Default::default() });
+        metrics.self_intersections = Some(count);
+        metrics.notes.clear();
+        judge(&scene, &mut metrics, 0.004);
+        metrics.notes
+    }
+
+    /// A cloth that ends through itself with self-collision on is said to, and for a
+    /// garment the note says how sewing lets panels cross; with self-collision off
+    /// crossing is what was asked for, and nothing is said.
+    #[test]
+    fn a_cloth_ending_through_itself_is_noted() {
+        let notes = notes_with_crossings(true, 3);
+        let note = notes.iter().find(|n| n.contains("passing through itself in 3 places")).unwrap_or_else(|| panic!("{notes:?}"));
+        assert!(note.contains("sewn with self-collision off"), "{note}");
+        assert!(notes_with_crossings(true, 0).iter().all(|n| !n.contains("through itself")));
+        assert!(notes_with_crossings(false, 3).iter().all(|n| !n.contains("through itself")));
+    }
 
     /// A garment's cloth is its pattern: a camera 1.2 m from a skirt frames it (the
     /// largest gore, about 0.6 m, spans hundreds of pixels), one 1 km away does not.

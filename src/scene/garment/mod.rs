@@ -104,6 +104,9 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
     let pairs = garment.seam_pairs();
     let mut model = Model::from_panels(&garment.surface, &pairs, fabric, options)?;
     let x = garment.positions.clone();
+    if config.contact.self_collision {
+        check_uncrossed(&garment, &model)?;
+    }
     for &v in &garment.pinned {
         model.pin(v, x[v as usize]);
     }
@@ -157,6 +160,29 @@ fn check_outside(garment: &Garment, form: &Prop, thickness: f64) -> Result<(), S
         }
     }
     Ok(())
+}
+
+/// Refuses panels placed through each other (or a panel through itself), naming them:
+/// self-collision keeps cloth from crossing, so it could never part them, and the garment
+/// would end tangled.
+fn check_uncrossed(garment: &Garment, model: &Model) -> Result<(), SceneError> {
+    let panel_of = |v: u32| garment.offsets.partition_point(|&o| o <= v) - 1;
+    let mut pairs = std::collections::BTreeMap::<(usize, usize), usize>::new();
+    for (e, t) in crate::sim::contact::self_intersections(&garment.positions, &model.triangles, &model.edges) {
+        let (a, b) = (panel_of(model.edges[e][0]), panel_of(model.triangles[t][0]));
+        *pairs.entry((a.min(b), a.max(b))).or_default() += 1;
+    }
+    let Some((&(a, b), &n)) = pairs.iter().next() else { return Ok(()) };
+    let name = |p: usize| &garment.names[p].0;
+    let which = if a == b { format!("garment.panels '{}' starts through itself", name(a)) } else { format!("garment.panels '{}' and '{}' start through each other", name(a), name(b)) };
+    let more = match pairs.len() - 1 {
+        0 => String::new(),
+        m => format!(" (and {m} more pairs of panels)"),
+    };
+    Err(SceneError::Setup(format!(
+        "{which}: {n} edges cross as placed{more}; self-collision keeps cloth from crossing, so it could never part them. \
+         Place them apart (placement.angle_deg, distance or height)"
+    )))
 }
 
 /// The form's horizontal section at height `z`: `count` points found by rays from outside

@@ -361,6 +361,11 @@ fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges:
 
 /// Edge–triangle crossings in a mesh (edges that share no vertex with the triangle).
 pub fn count_self_intersections(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]]) -> usize {
+    self_intersections(x, triangles, edges).len()
+}
+
+/// The edge–triangle crossings in a mesh, as (edge, triangle) indices.
+pub fn self_intersections(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]]) -> Vec<(usize, usize)> {
     let cell = mean_edge(x, triangles).max(1e-6);
     let boxes: Vec<_> = triangles
         .iter()
@@ -370,9 +375,9 @@ pub fn count_self_intersections(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u
         })
         .collect();
     let hash = SpatialHash::new(cell, &boxes);
-    let mut count = 0;
+    let mut found = Vec::new();
     let mut seen = Vec::new();
-    for [a, b] in edges {
+    for (e, [a, b]) in edges.iter().enumerate() {
         let (p, q) = (x[*a as usize], x[*b as usize]);
         seen.clear();
         hash.query_box(p.min(q), p.max(q), |t| {
@@ -387,11 +392,11 @@ pub fn count_self_intersections(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u
             }
             let c = tri.map(|i| x[i as usize]);
             if segment_crosses_triangle(p, q, c[0], c[1], c[2]) {
-                count += 1;
+                found.push((e, t as usize));
             }
         }
     }
-    count
+    found
 }
 
 #[cfg(test)]
