@@ -126,6 +126,16 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
             }
         ));
     }
+    if let (Some(false), true, None, Some(limit)) = (metrics.settled, metrics.stable, &metrics.stopped_at_limit, config.scene.settle_speed) {
+        metrics.notes.push(format!(
+            "not settled: at {} s the cloth still moved at {} mm/s RMS (scene.settle_speed = {} mm/s, held for scene.settle_window = {} s), \
+             so its measures are of a cloth in motion; run longer (--duration, or scene.duration)",
+            short(scene.state.time),
+            short(1e3 * scene.rms_speed()),
+            short(1e3 * limit),
+            short(config.scene.settle_window)
+        ));
+    }
     let end = scene.state.time;
     // The time is a sum of steps: a run to a motion's end may fall short of it by round-off.
     let unfinished = !scene.model.motions_finished(end * (1.0 + 1e-9) + 1e-12);
@@ -169,6 +179,19 @@ mod tests {
         assert!(note.contains("sewn with self-collision off"), "{note}");
         assert!(notes_with_crossings(true, 0).iter().all(|n| !n.contains("through itself")));
         assert!(notes_with_crossings(false, 3).iter().all(|n| !n.contains("through itself")));
+    }
+
+    /// A run that ends before the cloth settles says so, with the speed it still had and
+    /// the key that sets the limit; a scene that does not watch settling says nothing.
+    #[test]
+    fn a_run_that_ends_unsettled_says_so() {
+        let notes = notes_with_crossings(true, 0);
+        let note = notes.iter().find(|n| n.starts_with("not settled")).unwrap_or_else(|| panic!("{notes:?}"));
+        assert!(note.contains("scene.settle_speed = 1 mm/s") && note.contains("--duration"), "{note}");
+        let (config, _) = crate::scene::load_scene("tensile-warp", &[]).unwrap();
+        let mut scene = Scene::build(config).unwrap();
+        let (metrics, _) = crate::scene::run_scene(&mut scene, "tensile", crate::scene::RunOptions { duration: Some(0.002), ..Default::default() });
+        assert!(metrics.settled.is_none() && metrics.notes.iter().all(|n| !n.starts_with("not settled")), "{:?}", metrics.notes);
     }
 
     /// A garment's cloth is its pattern: a camera 1.2 m from a skirt frames it (the

@@ -178,6 +178,14 @@ impl StepRecord {
     }
 }
 
+impl Scene {
+    /// The cloth's mass-weighted RMS speed √(2 KE / M), m/s: what settling is judged by.
+    pub fn rms_speed(&self) -> f64 {
+        let total_mass: f64 = self.model.mass.iter().sum();
+        (2.0 * self.state.kinetic_energy(&self.model) / total_mass).sqrt()
+    }
+}
+
 /// Watches a scene for settling (`scene.settle_speed`): the cloth's mass-weighted RMS
 /// speed stays below that speed for `scene.settle_window` seconds, once every prescribed
 /// motion and the gravity ramp are done. `rosette run` then stops, and the viewer pauses.
@@ -211,8 +219,7 @@ impl SettleWatch {
 
     /// The mass-weighted RMS speed √(2 KE / M), m/s.
     pub fn rms_speed(&self, scene: &Scene) -> f64 {
-        let total_mass: f64 = scene.model.mass.iter().sum();
-        (2.0 * scene.state.kinetic_energy(&scene.model) / total_mass).sqrt()
+        scene.rms_speed()
     }
 
     /// Takes the state after a step, whose RMS speed is `rms`; the time the cloth settled
