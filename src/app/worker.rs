@@ -379,7 +379,7 @@ impl WorkerState {
                 // cost of a solve per step. Not while the mouse holds it, and only once:
                 // Play after the pause runs on to the scene's end.
                 let settled = self.drag.is_none() && {
-                    let rms = self.settle.rms_speed(&self.scene);
+                    let rms = self.scene.rms_speed();
                     self.settle.observe(&self.scene, rms).is_some()
                 };
                 if self.drag.is_some() {

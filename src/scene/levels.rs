@@ -52,7 +52,7 @@ impl Scene {
     pub(super) fn refine_if_settled(&mut self) {
         let Some(mut levels) = self.levels.take() else { return };
         if !levels.is_final() {
-            let rms = levels.watch.rms_speed(self);
+            let rms = self.rms_speed();
             if levels.watch.observe_level(self, rms).is_some() {
                 let next = levels.pending.remove(0);
                 self.continue_on(next);

@@ -217,11 +217,6 @@ impl SettleWatch {
         self.speed.is_some()
     }
 
-    /// The mass-weighted RMS speed √(2 KE / M), m/s.
-    pub fn rms_speed(&self, scene: &Scene) -> f64 {
-        scene.rms_speed()
-    }
-
     /// Takes the state after a step, whose RMS speed is `rms`; the time the cloth settled
     /// once it has. On the fast path only the scene's own mesh counts (its coarser levels
     /// settle on their way to it).
@@ -300,7 +295,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             }
         };
         tally.add(&report);
-        let rms = settle.rms_speed(scene);
+        let rms = scene.rms_speed();
         if let Some(f) = on_step.as_deref_mut() {
             f(&StepRecord::new(scene, &report, rms, cpu.elapsed().as_secs_f64()));
         }
