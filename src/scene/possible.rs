@@ -119,8 +119,9 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
         metrics.notes.push(format!(
             "the cloth ends passing through itself in {n} places though contact.self_collision is on: the folds there are not physical{}",
             if scene.garment.is_some() {
-                "; a garment is sewn with self-collision off (a seam's two sides must meet), so a panel its seams pull across \
-                 another can pass through it: place the panels so that none lies between two it is sewn to"
+                "; while a garment is sewn, self-collision leaves out the cloth near each seam still open (its two sides must \
+                 meet), so panels can pass through each other there: place each panel with its seams facing the sides they \
+                 are sewn to, and none lying over another"
             } else {
                 ""
             }
@@ -176,7 +177,7 @@ mod tests {
     fn a_cloth_ending_through_itself_is_noted() {
         let notes = notes_with_crossings(true, 3);
         let note = notes.iter().find(|n| n.contains("passing through itself in 3 places")).unwrap_or_else(|| panic!("{notes:?}"));
-        assert!(note.contains("sewn with self-collision off"), "{note}");
+        assert!(note.contains("near each seam still open"), "{note}");
         assert!(notes_with_crossings(true, 0).iter().all(|n| !n.contains("through itself")));
         assert!(notes_with_crossings(false, 3).iter().all(|n| !n.contains("through itself")));
     }

@@ -6,11 +6,11 @@
 //!          up front (so a pattern that cannot be welded is refused before any work)
 //!   sew:   springs ½k·max(0, d − s(t)·d₀)², the slack s(t) = max(0, 1 − t/ramp), pull
 //!          seam pairs together and attached edges onto the form on schedule, then
-//!          stiffen while a seam is still held open; self-collision off (the seam's two
-//!          sides must meet)
+//!          stiffen while a seam is still held open; self-collision as the scene asks,
+//!          less the pairs near a common seam (whose two sides must meet)
 //!   weld:  once every pair is within `closed_share` of the contact thickness: pairs
 //!          merged, the welded model takes over (membrane and bending across the seams),
-//!          attached vertices pinned where they are, self-collision on
+//!          attached vertices pinned where they are, self-collision everywhere
 //! ```
 
 pub mod rig;
@@ -19,7 +19,7 @@ use crate::settings::SceneConfig;
 use crate::settings::validate::MAX_SEWING_STIFFNESS;
 use super::{Scene, SceneError};
 use crate::garment::{self, Garment, form};
-use crate::sim::contact::{ContactModel, ContactSettings, Prop, PropShape};
+use crate::sim::contact::{ContactModel, Prop, PropShape};
 use crate::sim::model::PanelSurface;
 use crate::sim::{Model, PhysicsOptions, State};
 use glam::{DQuat, DVec2, DVec3};
@@ -41,8 +41,10 @@ pub struct Sewing {
     weld_map: Vec<u32>,
     /// Vertices pinned once the garment is sewn (attached ones), unsewn numbering.
     pin_after: Vec<u32>,
-    /// Self-collision as the scene asks for it, on from the weld.
-    self_collision: bool,
+    /// Each seam's vertex pairs (unsewn numbering) and whether it was open (a pair
+    /// farther apart than `closed_gap`) before the last step.
+    seams: Vec<Vec<[u32; 2]>>,
+    open: Vec<bool>,
     /// When the seams were welded, and the largest gap then, m.
     pub sewn_at: Option<f64>,
     pub gap_at_weld: Option<f64>,
@@ -114,12 +116,13 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
     model.sewing.start(&x);
     model.sewing.slack = 1.0;
     let (welded_surface, weld_map) = weld_surface(&garment.surface, &pairs);
+    model.sewing.welded = weld_map.clone();
     let mut welded = Model::from_panels(&welded_surface, &[], fabric, options)?;
     let mut props = super::props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
     props.insert(0, form);
     let settings = config.contact;
     welded.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
-    model.contact = Some(ContactModel::new(props.clone(), ContactSettings { self_collision: false, ..settings }).map_err(SceneError::Setup)?);
+    model.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
     let pin_after: Vec<u32> = model.sewing.anchors.iter().map(|a| a.0).collect();
     let sewing = Sewing {
         stiffness: g.sewing_stiffness,
@@ -130,7 +133,8 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
         welded: Some(welded),
         weld_map,
         pin_after,
-        self_collision: config.contact.self_collision,
+        seams: garment.seams.clone(),
+        open: Vec::new(),
         sewn_at: None,
         gap_at_weld: None,
     };
@@ -294,9 +298,27 @@ impl Scene {
     /// Before a step of a garment still being sewn: the springs' slack and stiffness at
     /// the step's end time.
     pub(super) fn sew_before_step(&mut self) {
-        let Some(sewing) = &self.garment else { return };
+        let Some(sewing) = &mut self.garment else { return };
         if sewing.is_sewn() {
             return;
+        }
+        // Self-collision leaves out the pairs near a seam while the seam is open, from the
+        // start until it first closes. A seam closed at the start, or since, keeps its
+        // sides apart as the welded cloth will, even if the sewing of others pulls it open
+        // again: GarmentCode's shirt starts with its centre front closed, the other seams
+        // drew it 17 mm open, and its two fronts, left out there, folded through each other
+        // in 20 places.
+        let x = &self.state.x;
+        let first = sewing.open.is_empty();
+        let open: Vec<bool> = sewing
+            .seams
+            .iter()
+            .enumerate()
+            .map(|(s, seam)| (first || sewing.open[s]) && seam.iter().any(|&[a, b]| x[a as usize].distance(x[b as usize]) > sewing.closed_gap))
+            .collect();
+        if open != sewing.open {
+            self.model.sewing.bands = crate::sim::model::seam_bands(&sewing.seams, &open, &self.model.triangles, x.len());
+            sewing.open = open;
         }
         let t = self.state.time + self.integrator.dt;
         self.model.sewing.slack = (1.0 - t / sewing.ramp).max(0.0);
@@ -337,9 +359,6 @@ impl Scene {
         for v in self.model.fixed.iter().enumerate().filter(|(_, f)| **f).map(|(v, _)| v as u32).chain(sewing.pin_after.iter().copied()) {
             let w = sewing.weld_map[v as usize];
             model.pin(w, position[w as usize]);
-        }
-        if let Some(contact) = &mut model.contact {
-            contact.settings.self_collision = sewing.self_collision;
         }
         model.options = self.model.options;
         model.options.damping = sewing.damping.1;

@@ -12,8 +12,10 @@ use std::borrow::Cow;
 #[derive(Debug, Clone, Default)]
 pub struct NearPairs {
     origin: Vec<DVec3>,
-    /// Triangle and edge counts of the cloth it was built for.
+    /// Triangle and edge counts of the cloth it was built for, and a checksum of the
+    /// seam bands it left out (`Cloth::seam_bands`).
     topology: (usize, usize),
+    bands: u64,
     reach: f64,
     /// (vertex, triangle index).
     vertex_triangle: Vec<(u32, u32)>,
@@ -27,7 +29,7 @@ impl NearPairs {
     /// twice the largest displacement since the list was built and by twice `motion`
     /// (both measured from the cloth's mean displacement where `relative`).
     fn covers(&self, cloth: Cloth, start: &[DVec3], motion: f64, margin: f64, relative: bool) -> bool {
-        if self.origin.len() != start.len() || self.topology != (cloth.triangles.len(), cloth.edges.len()) {
+        if self.origin.len() != start.len() || self.topology != (cloth.triangles.len(), cloth.edges.len()) || self.bands != bands_checksum(cloth) {
             return false;
         }
         let moved = largest_move(&self.origin, start, relative);
@@ -35,9 +37,9 @@ impl NearPairs {
     }
 
     /// The pairs within `reach` of each other at `x`, listed for reuse from there.
-    fn build(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], reach: f64) -> Self {
+    fn build(x: &[DVec3], cloth: Cloth, reach: f64) -> Self {
         let points: Vec<_> = x.iter().map(|&p| (p, p)).collect();
-        Self { origin: x.to_vec(), ..Self::search(&points, mean_edge(x, triangles), triangles, edges, reach) }
+        Self { origin: x.to_vec(), ..Self::search(&points, mean_edge(x, cloth.triangles), cloth, reach) }
     }
 
     /// The pairs whose paths from `a` to `b`, less the motion `centre` that all share, come
@@ -51,14 +53,16 @@ impl NearPairs {
     /// includes the step's whole fall under gravity (h²g, 4 cm at 64 ms), and with it the
     /// boxes of its sloping skirt met 1.8 million pairs at 20 000 triangles, 0.45 s a
     /// search, where the same step's search along its actual paths met 30 000.
-    pub(super) fn swept(a: &[DVec3], b: &[DVec3], centre: DVec3, triangles: &[[u32; 3]], edges: &[[u32; 2]], reach: f64) -> Self {
+    pub(super) fn swept(a: &[DVec3], b: &[DVec3], centre: DVec3, cloth: Cloth, reach: f64) -> Self {
         let boxes: Vec<_> = a.iter().zip(b).map(|(&p, &q)| path_box(p, q, centre)).collect();
-        Self::search(&boxes, mean_edge(a, triangles), triangles, edges, reach)
+        Self::search(&boxes, mean_edge(a, cloth.triangles), cloth, reach)
     }
 
     /// Vertex–triangle and edge–edge pairs whose boxes (vertex v's `points[v]`, a triangle's
-    /// or an edge's the union of its corners') come within `reach`.
-    fn search(points: &[(DVec3, DVec3)], edge_length: f64, triangles: &[[u32; 3]], edges: &[[u32; 2]], reach: f64) -> Self {
+    /// or an edge's the union of its corners') come within `reach`, less those near a
+    /// common seam still being sewn.
+    fn search(points: &[(DVec3, DVec3)], edge_length: f64, cloth: Cloth, reach: f64) -> Self {
+        let (triangles, edges) = (cloth.triangles, cloth.edges);
         let parallel = triangles.len() >= PARALLEL_TRIANGLES;
         let cell = edge_length.max(reach).max(1e-6);
         let hash = SpatialHash::new(cell, points);
@@ -77,7 +81,7 @@ impl NearPairs {
             let (lo, hi) = union(&tri);
             let first = found.len();
             hash.query_box(lo - pad, hi + pad, |v| {
-                if taken[v as usize] != t as u32 && !tri.contains(&v) && boxes_overlap(points[v as usize], (lo, hi), reach) {
+                if taken[v as usize] != t as u32 && !tri.contains(&v) && boxes_overlap(points[v as usize], (lo, hi), reach) && !cloth.sewn_together(&[v], &tri) {
                     taken[v as usize] = t as u32;
                     found.push((v, t as u32));
                 }
@@ -91,15 +95,28 @@ impl NearPairs {
             let first = found.len();
             hash.query_box(boxes[e].0 - pad, boxes[e].1 + pad, |f| {
                 let [c, d] = edges[f as usize];
-                if (f as usize) > e && taken[f as usize] != e as u32 && c != a && c != b && d != a && d != b && boxes_overlap(boxes[e], boxes[f as usize], reach) {
+                if (f as usize) > e
+                    && taken[f as usize] != e as u32
+                    && c != a
+                    && c != b
+                    && d != a
+                    && d != b
+                    && boxes_overlap(boxes[e], boxes[f as usize], reach)
+                    && !cloth.sewn_together(&[a, b], &[c, d])
+                {
                     taken[f as usize] = e as u32;
                     found.push((e as u32, f));
                 }
             });
             found[first..].sort_unstable();
         });
-        Self { origin: Vec::new(), topology: (triangles.len(), edges.len()), reach, vertex_triangle, edge_edge }
+        Self { origin: Vec::new(), topology: (triangles.len(), edges.len()), bands: bands_checksum(cloth), reach, vertex_triangle, edge_edge }
     }
+}
+
+/// A checksum of the cloth's seam bands: a list built with other bands left out other pairs.
+fn bands_checksum(cloth: Cloth) -> u64 {
+    cloth.seam_bands.iter().enumerate().fold(0u64, |sum, (v, &bits)| sum.wrapping_mul(31).wrapping_add(bits ^ v as u64))
 }
 
 /// From this relative motion in a step, in mean edges (twice the largest centred move),
@@ -144,7 +161,7 @@ impl ContactModel {
     /// pairs that come within `margin`, renewed if it does not cover them.
     fn near_pairs<'n>(&self, cloth: Cloth, near: &'n mut NearPairs, start: &[DVec3], motion: f64, margin: f64) -> &'n NearPairs {
         if !near.covers(cloth, start, motion, margin, self.settings.relative_motion) {
-            *near = NearPairs::build(start, cloth.triangles, cloth.edges, margin + 2.0 * motion + skin(cloth));
+            *near = NearPairs::build(start, cloth, margin + 2.0 * motion + skin(cloth));
         }
         near
     }
@@ -161,7 +178,7 @@ impl ContactModel {
         let motion = largest_move(start, end, relative);
         if relative && 2.0 * motion > SWEPT_FROM_EDGES * cloth.mean_edge_length && !near.covers(cloth, start, motion, margin, relative) {
             let centre = common_motion(start, end, relative);
-            return Cow::Owned(NearPairs::swept(start, end, centre, cloth.triangles, cloth.edges, margin + allowance));
+            return Cow::Owned(NearPairs::swept(start, end, centre, cloth, margin + allowance));
         }
         Cow::Borrowed(self.near_pairs(cloth, near, start, motion, margin))
     }

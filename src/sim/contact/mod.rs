@@ -65,6 +65,27 @@ pub struct Cloth<'a> {
     pub mass: &'a [f64],
     /// Mean rest edge length, m.
     pub mean_edge_length: f64,
+    /// Per vertex, the seams being sewn that it lies near (`Sewing::bands`; empty: none):
+    /// self-collision leaves out pairs near a common seam, whose sides must meet.
+    pub seam_bands: &'a [u64],
+    /// Per vertex, the vertex it becomes once the seams are welded (empty: itself): pairs
+    /// that will share a vertex then are neighbours now.
+    pub welded: &'a [u32],
+}
+
+impl Cloth<'_> {
+    /// Whether self-collision leaves out the pair of these two sides: both near a seam
+    /// still being sewn.
+    pub fn sewn_together(&self, one: &[u32], other: &[u32]) -> bool {
+        if !self.welded.is_empty() && one.iter().any(|&a| other.iter().any(|&b| self.welded[a as usize] == self.welded[b as usize])) {
+            return true;
+        }
+        if self.seam_bands.is_empty() {
+            return false;
+        }
+        let bits = |side: &[u32]| side.iter().fold(0u64, |b, &v| b | self.seam_bands[v as usize]);
+        bits(one) & bits(other) != 0
+    }
 }
 
 /// Contact parameters, SI units: the `[contact]` section of a scene file.

@@ -16,7 +16,7 @@ pub(crate) mod tests;
 
 pub use membrane::CompressedEdges;
 pub use motion::Motion;
-pub use sewing::{PanelSurface, Sewing};
+pub use sewing::{PanelSurface, Sewing, seam_bands};
 
 use crate::sim::contact::{Cloth, ContactModel};
 use crate::sim::linalg::{BlockCsr, ScalarCsr};
@@ -235,7 +235,7 @@ impl Model {
 
     /// What contact reads of the cloth.
     pub fn cloth(&self) -> Cloth<'_> {
-        Cloth { triangles: &self.triangles, edges: &self.edges, fixed: &self.fixed, mass: &self.mass, mean_edge_length: self.mean_edge_length }
+        Cloth { triangles: &self.triangles, edges: &self.edges, fixed: &self.fixed, mass: &self.mass, mean_edge_length: self.mean_edge_length, seam_bands: &self.sewing.bands, welded: &self.sewing.welded }
     }
 
     /// The texture space: per-vertex coordinates and the warp's angle from their x axis

@@ -91,6 +91,55 @@ pub struct Sewing {
     pub start_lengths: Vec<f64>,
     /// The share of its starting length each spring may still have, 1 to 0.
     pub slack: f64,
+    /// Per vertex, the seams whose sides it lies near (bit s mod 64 for seam s; empty: no
+    /// seams). While the seams close, self-collision leaves out pairs whose two sides lie
+    /// near a common seam, whose sides must meet, and keeps every other panel from
+    /// passing through (`seam_bands`).
+    pub bands: Vec<u64>,
+    /// Per vertex, its vertex once the seams are welded (empty: none).
+    pub welded: Vec<u32>,
+}
+
+/// How many rings of triangles around a seam's vertices its band takes in: a seam's sides
+/// meet at an angle, and a vertex two edges from the seam line stays farther than the
+/// self-collision layer (a fifth of an edge at most) from the other side wherever the two
+/// sides meet at more than about 6°.
+const BAND_RINGS: usize = 2;
+
+/// Each vertex's seam bits (see [`Sewing::bands`]): the vertices of each `open` seam's
+/// sides and those within `BAND_RINGS` edges of them over `triangles` (n vertices).
+pub fn seam_bands(seams: &[Vec<[u32; 2]>], open: &[bool], triangles: &[[u32; 3]], n: usize) -> Vec<u64> {
+    let mut neighbours = vec![Vec::new(); n];
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            neighbours[a].push(b as u32);
+            neighbours[b].push(a as u32);
+        }
+    }
+    let mut bands = vec![0u64; n];
+    for (s, seam) in seams.iter().enumerate().filter(|(s, _)| open[*s]) {
+        let bit = 1u64 << (s % 64);
+        let mut ring: Vec<u32> = seam.iter().flatten().copied().filter(|&v| bands[v as usize] & bit == 0).collect();
+        ring.sort_unstable();
+        ring.dedup();
+        for &v in &ring {
+            bands[v as usize] |= bit;
+        }
+        for _ in 0..BAND_RINGS {
+            let mut next = Vec::new();
+            for &v in &ring {
+                for &w in &neighbours[v as usize] {
+                    if bands[w as usize] & bit == 0 {
+                        bands[w as usize] |= bit;
+                        next.push(w);
+                    }
+                }
+            }
+            ring = next;
+        }
+    }
+    bands
 }
 
 impl Sewing {
@@ -271,5 +320,39 @@ mod tests {
         sewing.add_forces(&x, &mut f);
         assert!(f.iter().all(|fi| fi.length() < 1e-15) && sewing.energy(&x) == 0.0);
         assert!((sewing.largest_gap(&x) - x[0].distance(x[1])).abs() < 1e-15);
+    }
+
+    /// A seam's band is its sides' vertices and two rings of neighbours, and only while
+    /// the seam is open; pairs sharing a vertex once welded, or near a common open seam,
+    /// are left out of self-collision, and no other pair is.
+    #[test]
+    fn a_seam_band_takes_in_its_sides_and_two_rings_while_the_seam_is_open() {
+        use crate::sim::contact::Cloth;
+        // A strip of 6 by 2 squares, vertex (i, j) = 7j + i, sewn into a tube: column 0
+        // to column 6.
+        let id = |i: u32, j: u32| 7 * j + i;
+        let mut triangles = Vec::new();
+        for j in 0..2 {
+            for i in 0..6 {
+                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let seams = vec![(0..3).map(|j| [id(0, j), id(6, j)]).collect::<Vec<_>>()];
+        let bands = seam_bands(&seams, &[true], &triangles, 21);
+        for j in 0..3 {
+            for i in 0..7 {
+                assert_eq!(bands[id(i, j) as usize], if i == 3 { 0 } else { 1 }, "vertex ({i}, {j})");
+            }
+        }
+        assert!(seam_bands(&seams, &[false], &triangles, 21).iter().all(|&b| b == 0), "a closed seam has no band");
+        // Welded, column 6 becomes column 0.
+        let welded: Vec<u32> = (0..21).map(|v| if v % 7 == 6 { v - 6 } else { v }).collect();
+        let open = Cloth { triangles: &[], edges: &[], fixed: &[], mass: &[], mean_edge_length: 1.0, seam_bands: &bands, welded: &welded };
+        assert!(open.sewn_together(&[id(1, 1)], &[id(5, 0), id(6, 0), id(5, 1)]), "near the open seam, either side");
+        assert!(!open.sewn_together(&[id(3, 1)], &[id(4, 0), id(5, 0), id(5, 1)]), "the middle of the strip is not near the seam");
+        let closed = Cloth { seam_bands: &[], ..open };
+        assert!(closed.sewn_together(&[id(0, 0)], &[id(5, 0), id(6, 0), id(5, 1)]), "neighbours once welded");
+        assert!(!closed.sewn_together(&[id(1, 1)], &[id(5, 0), id(6, 0), id(5, 1)]), "a closed seam's sides collide as the welded cloth's");
     }
 }
