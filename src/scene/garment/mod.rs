@@ -41,8 +41,8 @@ pub struct Sewing {
     weld_map: Vec<u32>,
     /// Vertices pinned once the garment is sewn (attached ones), unsewn numbering.
     pin_after: Vec<u32>,
-    /// Each seam's vertex pairs (unsewn numbering) and whether it was open (a pair
-    /// farther apart than `closed_gap`) before the last step.
+    /// Each seam's vertex pairs (unsewn numbering), and whether it has been open (a pair
+    /// farther apart than `closed_gap`) from the start until the last step.
     seams: Vec<Vec<[u32; 2]>>,
     open: Vec<bool>,
     /// When the seams were welded, and the largest gap then, m.
@@ -106,8 +106,14 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
     let pairs = garment.seam_pairs();
     let mut model = Model::from_panels(&garment.surface, &pairs, fabric, options)?;
     let x = garment.positions.clone();
+    let (welded_surface, weld_map) = weld_surface(&garment.surface, &pairs);
+    let closed_gap = g.closed_share * thickness;
+    let open: Vec<bool> = garment.seams.iter().map(|seam| seam.iter().any(|&[a, b]| x[a as usize].distance(x[b as usize]) > closed_gap)).collect();
+    model.sewing.bands = crate::sim::model::seam_bands(&garment.seams, &open, &model.triangles, x.len());
+    model.sewing.welded = weld_map.clone();
     if config.contact.self_collision {
         check_uncrossed(&garment, &model)?;
+        check_apart(&garment, &model, config.contact.self_thickness_for(model.mean_edge_length))?;
     }
     for &v in &garment.pinned {
         model.pin(v, x[v as usize]);
@@ -115,8 +121,6 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
     model.sewing.anchors = anchors(&garment, &form, axis, thickness);
     model.sewing.start(&x);
     model.sewing.slack = 1.0;
-    let (welded_surface, weld_map) = weld_surface(&garment.surface, &pairs);
-    model.sewing.welded = weld_map.clone();
     let mut welded = Model::from_panels(&welded_surface, &[], fabric, options)?;
     let mut props = super::props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
     props.insert(0, form);
@@ -128,13 +132,13 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
         stiffness: g.sewing_stiffness,
         ramp: g.sewing_ramp,
         deadline: g.sewing_time,
-        closed_gap: g.closed_share * thickness,
+        closed_gap,
         damping: (g.sewing_damping, config.solver.damping),
         welded: Some(welded),
         weld_map,
         pin_after,
         seams: garment.seams.clone(),
-        open: Vec::new(),
+        open,
         sewn_at: None,
         gap_at_weld: None,
     };
@@ -186,6 +190,30 @@ fn check_uncrossed(garment: &Garment, model: &Model) -> Result<(), SceneError> {
     Err(SceneError::Setup(format!(
         "{which}: {n} edges cross as placed{more}; self-collision keeps cloth from crossing, so it could never part them. \
          Place them apart (placement.angle_deg, distance or height)"
+    )))
+}
+
+/// Refuses panels placed within the layer self-collision keeps between cloth layers
+/// (`reach`, m) of each other, or a panel folded onto itself, leaving out the pairs that
+/// the sewing must bring together: the layer's penalty would throw them apart in the first
+/// step, and the sewing then pulls one through the other (a gore placed 1 mm outside
+/// another ended its first second with 86 crossings, and failed Newton's tolerance with
+/// self-collision on).
+fn check_apart(garment: &Garment, model: &Model, reach: f64) -> Result<(), SceneError> {
+    let panel_of = |v: u32| garment.offsets.partition_point(|&o| o <= v) - 1;
+    let close = crate::sim::contact::pairs_within(&garment.positions, model.cloth(), reach);
+    let Some(&(v, t, gap)) = close.iter().min_by(|a, b| a.2.total_cmp(&b.2)) else { return Ok(()) };
+    let (a, b) = (panel_of(v), panel_of(model.triangles[t as usize][0]));
+    let (a, b) = (a.min(b), a.max(b));
+    let name = |p: usize| &garment.names[p].0;
+    let which = if a == b { format!("garment.panels '{}' starts folded onto itself", name(a)) } else { format!("garment.panels '{}' and '{}' start", name(a), name(b)) };
+    Err(SceneError::Setup(format!(
+        "{which} {:.1} mm apart at {:.3?} m ({} points closer than {:.1} mm, the layer self-collision keeps between cloth layers); \
+         the sewing would pull one through the other. Place them apart (placement.angle_deg, distance or height)",
+        1e3 * gap,
+        garment.positions[v as usize].to_array(),
+        close.len(),
+        1e3 * reach
     )))
 }
 
@@ -309,13 +337,7 @@ impl Scene {
         // drew it 17 mm open, and its two fronts, left out there, folded through each other
         // in 20 places.
         let x = &self.state.x;
-        let first = sewing.open.is_empty();
-        let open: Vec<bool> = sewing
-            .seams
-            .iter()
-            .enumerate()
-            .map(|(s, seam)| (first || sewing.open[s]) && seam.iter().any(|&[a, b]| x[a as usize].distance(x[b as usize]) > sewing.closed_gap))
-            .collect();
+        let open: Vec<bool> = sewing.seams.iter().zip(&sewing.open).map(|(seam, &open)| open && seam.iter().any(|&[a, b]| x[a as usize].distance(x[b as usize]) > sewing.closed_gap)).collect();
         if open != sewing.open {
             self.model.sewing.bands = crate::sim::model::seam_bands(&sewing.seams, &open, &self.model.triangles, x.len());
             sewing.open = open;

@@ -376,6 +376,21 @@ fn find_crossings(start: &[DVec3], end: &[DVec3], triangles: &[[u32; 3]], edges:
     found
 }
 
+/// The vertex–triangle pairs closer than `reach` at `x` that self-collision takes in (the
+/// triangle not holding the vertex, the two not near a common open seam nor neighbours once
+/// welded), as (vertex, triangle, distance).
+pub fn pairs_within(x: &[DVec3], cloth: Cloth, reach: f64) -> Vec<(u32, u32, f64)> {
+    let near = NearPairs::build(x, cloth, reach);
+    near.vertex_triangle
+        .iter()
+        .filter_map(|&(v, t)| {
+            let c = cloth.triangles[t as usize].map(|i| x[i as usize]);
+            let gap = (closest_point_triangle(x[v as usize], c[0], c[1], c[2]).0 - x[v as usize]).length();
+            (gap < reach).then_some((v, t, gap))
+        })
+        .collect()
+}
+
 /// Edge–triangle crossings in a mesh (edges that share no vertex with the triangle).
 pub fn count_self_intersections(x: &[DVec3], triangles: &[[u32; 3]], edges: &[[u32; 2]]) -> usize {
     self_intersections(x, triangles, edges).len()

@@ -47,7 +47,7 @@ pub mod geometry;
 pub mod props;
 mod step;
 
-pub use cloth::{NearPairs, count_self_intersections, self_intersections};
+pub use cloth::{NearPairs, count_self_intersections, pairs_within, self_intersections};
 pub use props::{MAX_REACH, Prop, PropError, PropShape, SurfacePoint};
 
 use glam::DVec3;
