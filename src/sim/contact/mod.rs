@@ -74,8 +74,9 @@ pub struct Cloth<'a> {
 }
 
 impl Cloth<'_> {
-    /// Whether self-collision leaves out the pair of these two sides: both near a seam
-    /// still being sewn.
+    /// Whether self-collision leaves out the pair of these two sides (a vertex and a
+    /// triangle's corners, or two edges): they will share a vertex once the seams are
+    /// welded, or both lie near a seam that is still open.
     pub fn sewn_together(&self, one: &[u32], other: &[u32]) -> bool {
         if !self.welded.is_empty() && one.iter().any(|&a| other.iter().any(|&b| self.welded[a as usize] == self.welded[b as usize])) {
             return true;
