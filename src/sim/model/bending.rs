@@ -312,9 +312,10 @@ fn stencils(triangles: &[[u32; 3]], n: usize, areas: &[f64], rest: &RestFrames, 
     // One gradient stencil per edge, shared by its triangles (for panels, in the frame of
     // the edge's first triangle, with the second triangle's placement in it), and the
     // rest points of the edge's hinge quad.
-    let mut gradient_of_edge: HashMap<[u32; 2], EdgeStencil> = HashMap::new();
-    let mut hinge_points: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
-    for (&edge, owners) in &edge_owner {
+    // Each edge's fit (and, on panels, its unfolded chart) is its own: they run in
+    // parallel, each giving the same result on any number of threads. On a 10k-triangle
+    // garment they were 2 s of the 3 s it took to build, on one thread.
+    let fit = |(&edge, owners): (&[u32; 2], &Vec<(usize, usize)>)| -> Result<_, ModelError> {
         let frame = frame_of(edge, owners[0].0);
         let at = |v: u32| frame.point(v);
         let midpoint = 0.5 * (at(edge[0]).expect("laid") + at(edge[1]).expect("laid"));
@@ -326,11 +327,28 @@ fn stencils(triangles: &[[u32; 3]], n: usize, areas: &[f64], rest: &RestFrames, 
             (EdgeFrame::Chart(chart), Some(&(t1, _))) => Some(chart.placements[&t1]),
             _ => None,
         };
-        if let (EdgeFrame::Chart(_), [(t0, k0), (t1, k1)]) = (&frame, &owners[..]) {
-            let quad = [edge[0], edge[1], triangles[*t0][*k0], triangles[*t1][*k1]];
-            hinge_points.insert(edge, quad.iter().map(|&v| (v, at(v).expect("the edge's triangles are laid"))).collect());
+        let quad = match (&frame, &owners[..]) {
+            (EdgeFrame::Chart(_), [(t0, k0), (t1, k1)]) => {
+                let quad = [edge[0], edge[1], triangles[*t0][*k0], triangles[*t1][*k1]];
+                Some(quad.iter().map(|&v| (v, at(v).expect("the edge's triangles are laid"))).collect::<Vec<_>>())
+            }
+            _ => None,
+        };
+        Ok((edge, (stencil, second), quad))
+    };
+    let fits: Vec<_> = if triangles.len() >= PARALLEL_TRIANGLES {
+        use rayon::prelude::*;
+        edge_owner.par_iter().map(fit).collect::<Result<_, _>>()?
+    } else {
+        edge_owner.iter().map(fit).collect::<Result<_, _>>()?
+    };
+    let mut gradient_of_edge: HashMap<[u32; 2], EdgeStencil> = HashMap::with_capacity(fits.len());
+    let mut hinge_points: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
+    for (edge, stencil, quad) in fits {
+        if let Some(quad) = quad {
+            hinge_points.insert(edge, quad);
         }
-        gradient_of_edge.insert(edge, (stencil, second));
+        gradient_of_edge.insert(edge, stencil);
     }
     let mut patches = Vec::with_capacity(triangles.len());
     for (t, tri) in triangles.iter().enumerate() {
