@@ -124,6 +124,7 @@ fn open_step_log(path: &Path) -> Result<Output, String> {
 }
 
 pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutputs, shot: &ScreenshotArgs) -> ExitCode {
+    let building = std::time::Instant::now();
     let mut scene = match prepare(spec, overrides, limits, outputs, shot) {
         Ok(scene) => scene,
         Err(e) => return bad_input(e),
@@ -180,7 +181,9 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
         max_wall_seconds: Some(limits.max_wall),
         on_state: Some(&mut on_state),
     };
-    let (metrics, error) = run_scene(&mut scene, &name, options);
+    let build_seconds = building.elapsed().as_secs_f64();
+    let (mut metrics, error) = run_scene(&mut scene, &name, options);
+    metrics.build_seconds = Some(build_seconds);
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
@@ -208,13 +211,14 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
     }
     if outputs.metrics.is_none() {
         errln!(
-            "{name}: {} steps of {} s with {}, {:.3} s simulated in {:.2} s wall ({:.4} CPU s per 10 ms simulated)",
+            "{name}: {} steps of {} s with {}, {:.3} s simulated in {:.2} s wall ({:.4} CPU s per 10 ms simulated), after {:.2} s building the scene",
             metrics.steps,
             short(metrics.dt),
             metrics.integrator,
             metrics.simulated_seconds,
             metrics.wall_seconds,
-            metrics.cpu_seconds_per_10ms
+            metrics.cpu_seconds_per_10ms,
+            build_seconds
         );
         outln!("{}", serde_json::to_string_pretty(&metrics.measures).expect("JSON values serialise"));
     }
