@@ -123,6 +123,21 @@ fn open_step_log(path: &Path) -> Result<Output, String> {
     Ok(out)
 }
 
+/// A progress bar, hidden until shown, only where someone watches (stderr a terminal).
+fn progress_bar(name: &str) -> Option<indicatif::ProgressBar> {
+    std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(1000);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% ({elapsed}, eta {eta})")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_message(name.to_string());
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+        bar
+    })
+}
+
 pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutputs, shot: &ScreenshotArgs) -> ExitCode {
     let building = std::time::Instant::now();
     let mut scene = match prepare(spec, overrides, limits, outputs, shot) {
@@ -136,18 +151,8 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
         Err(e) => return bad_input(e),
     };
     let name = Path::new(spec).file_stem().map_or(spec.to_string(), |s| s.to_string_lossy().into_owned());
-    // A progress bar only where someone watches, and only if the run lasts.
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let bar = indicatif::ProgressBar::new(1000);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent}% ({elapsed}, eta {eta})")
-                .expect("valid template")
-                .progress_chars("=> "),
-        );
-        bar.set_message(name.clone());
-        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-        bar
-    });
+    let bar = progress_bar(&name);
+    // Shown only if the run lasts.
     let started = std::time::Instant::now();
     let mut on_progress = |fraction: f64| {
         if let Some(bar) = &bar {

@@ -303,53 +303,7 @@ fn stencils(triangles: &[[u32; 3]], n: usize, areas: &[f64], rest: &RestFrames, 
         (_, Some(charts)) => EdgeFrame::Chart(charts.unfold(first, edge)),
         (RestFrames::Panels { .. }, None) => unreachable!("panels have charts"),
     };
-    // A clamped region moves rigidly: its curvature is zero while the cloth beside it bends,
-    // so a fit across the clamp line would smear that jump and make the root too soft.
-    // Edges inside the clamp (both ends rigid) fit rigid vertices only, which gives the
-    // clamp's exact slope; other edges fit free vertices plus the clamp line itself.
-    let on_clamp_line: Vec<bool> =
-        (0..n).map(|v| rigid[v] && vertex_triangles[v].iter().any(|&t| triangles[t as usize].iter().any(|&u| !rigid[u as usize]))).collect();
-    // One gradient stencil per edge, shared by its triangles (for panels, in the frame of
-    // the edge's first triangle, with the second triangle's placement in it), and the
-    // rest points of the edge's hinge quad.
-    // Each edge's fit (and, on panels, its unfolded chart) is its own: they run in
-    // parallel, each giving the same result on any number of threads. On a 10k-triangle
-    // garment they were 2 s of the 3 s it took to build, on one thread.
-    let fit = |(&edge, owners): (&[u32; 2], &Vec<(usize, usize)>)| -> Result<_, ModelError> {
-        let frame = frame_of(edge, owners[0].0);
-        let at = |v: u32| frame.point(v);
-        let midpoint = 0.5 * (at(edge[0]).expect("laid") + at(edge[1]).expect("laid"));
-        let inside_clamp = rigid[edge[0] as usize] && rigid[edge[1] as usize];
-        let usable = |v: u32| at(v).is_some() && if inside_clamp { rigid[v as usize] } else { !rigid[v as usize] || on_clamp_line[v as usize] };
-        let stencil = edge_gradient_stencil(triangles, &vertex_triangles, &|v| at(v).expect("usable"), edge, midpoint, scale, usable)
-            .ok_or(ModelError::SingularBendingStencil { triangle: owners[0].0 })?;
-        let second = match (&frame, owners.get(1)) {
-            (EdgeFrame::Chart(chart), Some(&(t1, _))) => Some(chart.placements[&t1]),
-            _ => None,
-        };
-        let quad = match (&frame, &owners[..]) {
-            (EdgeFrame::Chart(_), [(t0, k0), (t1, k1)]) => {
-                let quad = [edge[0], edge[1], triangles[*t0][*k0], triangles[*t1][*k1]];
-                Some(quad.iter().map(|&v| (v, at(v).expect("the edge's triangles are laid"))).collect::<Vec<_>>())
-            }
-            _ => None,
-        };
-        Ok((edge, (stencil, second), quad))
-    };
-    let fits: Vec<_> = if triangles.len() >= PARALLEL_TRIANGLES {
-        use rayon::prelude::*;
-        edge_owner.par_iter().map(fit).collect::<Result<_, _>>()?
-    } else {
-        edge_owner.iter().map(fit).collect::<Result<_, _>>()?
-    };
-    let mut gradient_of_edge: HashMap<[u32; 2], EdgeStencil> = HashMap::with_capacity(fits.len());
-    let mut hinge_points: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
-    for (edge, stencil, quad) in fits {
-        if let Some(quad) = quad {
-            hinge_points.insert(edge, quad);
-        }
-        gradient_of_edge.insert(edge, stencil);
-    }
+    let (gradient_of_edge, hinge_points) = edge_fits(&edge_owner, &frame_of, triangles, &vertex_triangles, rigid, scale)?;
     let mut patches = Vec::with_capacity(triangles.len());
     for (t, tri) in triangles.iter().enumerate() {
         let area = areas[t];
@@ -409,6 +363,68 @@ fn stencils(triangles: &[[u32; 3]], n: usize, areas: &[f64], rest: &RestFrames, 
         }
     }
     Ok((patches, hinges))
+}
+
+/// Each edge's gradient stencil, with (on panels) the second triangle's placement in the
+/// edge's chart, and the rest points of the edge's hinge quad where it has a chart.
+#[allow(clippy::type_complexity)]
+fn edge_fits<'r>(
+    edge_owner: &HashMap<[u32; 2], Vec<(usize, usize)>>,
+    frame_of: &(dyn Fn([u32; 2], usize) -> EdgeFrame<'r> + Sync),
+    triangles: &[[u32; 3]],
+    vertex_triangles: &[Vec<u32>],
+    rigid: &[bool],
+    scale: f64,
+) -> Result<(HashMap<[u32; 2], EdgeStencil>, HashMap<[u32; 2], Vec<(u32, DVec2)>>), ModelError> {
+    let n = vertex_triangles.len();
+    // A clamped region moves rigidly: its curvature is zero while the cloth beside it bends,
+    // so a fit across the clamp line would smear that jump and make the root too soft.
+    // Edges inside the clamp (both ends rigid) fit rigid vertices only, which gives the
+    // clamp's exact slope; other edges fit free vertices plus the clamp line itself.
+    let on_clamp_line: Vec<bool> =
+        (0..n).map(|v| rigid[v] && vertex_triangles[v].iter().any(|&t| triangles[t as usize].iter().any(|&u| !rigid[u as usize]))).collect();
+    // One gradient stencil per edge, shared by its triangles (for panels, in the frame of
+    // the edge's first triangle, with the second triangle's placement in it), and the
+    // rest points of the edge's hinge quad. Each edge's fit (and, on panels, its unfolded
+    // chart) is its own: they run in parallel, each giving the same result on any number
+    // of threads. On a 10k-triangle garment they were 2 s of the 3 s it took to build, on
+    // one thread.
+    let fit = |(&edge, owners): (&[u32; 2], &Vec<(usize, usize)>)| -> Result<_, ModelError> {
+        let frame = frame_of(edge, owners[0].0);
+        let at = |v: u32| frame.point(v);
+        let midpoint = 0.5 * (at(edge[0]).expect("laid") + at(edge[1]).expect("laid"));
+        let inside_clamp = rigid[edge[0] as usize] && rigid[edge[1] as usize];
+        let usable = |v: u32| at(v).is_some() && if inside_clamp { rigid[v as usize] } else { !rigid[v as usize] || on_clamp_line[v as usize] };
+        let stencil = edge_gradient_stencil(triangles, vertex_triangles, &|v| at(v).expect("usable"), edge, midpoint, scale, usable)
+            .ok_or(ModelError::SingularBendingStencil { triangle: owners[0].0 })?;
+        let second = match (&frame, owners.get(1)) {
+            (EdgeFrame::Chart(chart), Some(&(t1, _))) => Some(chart.placements[&t1]),
+            _ => None,
+        };
+        let quad = match (&frame, &owners[..]) {
+            (EdgeFrame::Chart(_), [(t0, k0), (t1, k1)]) => {
+                let quad = [edge[0], edge[1], triangles[*t0][*k0], triangles[*t1][*k1]];
+                Some(quad.iter().map(|&v| (v, at(v).expect("the edge's triangles are laid"))).collect::<Vec<_>>())
+            }
+            _ => None,
+        };
+        Ok((edge, (stencil, second), quad))
+    };
+    let fits: Vec<_> = if triangles.len() >= PARALLEL_TRIANGLES {
+        use rayon::prelude::*;
+        edge_owner.par_iter().map(fit).collect::<Result<_, _>>()?
+    } else {
+        edge_owner.iter().map(fit).collect::<Result<_, _>>()?
+    };
+    let mut gradient_of_edge: HashMap<[u32; 2], EdgeStencil> = HashMap::with_capacity(fits.len());
+    let mut hinge_points: HashMap<[u32; 2], Vec<(u32, DVec2)>> = HashMap::new();
+    for (edge, stencil, quad) in fits {
+        if let Some(quad) = quad {
+            hinge_points.insert(edge, quad);
+        }
+        gradient_of_edge.insert(edge, stencil);
+    }
+    Ok((gradient_of_edge, hinge_points))
 }
 
 /// A stabilisation of the fitted bending stencils against mesh-scale oscillation.
