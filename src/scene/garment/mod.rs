@@ -37,8 +37,6 @@ pub struct Sewing {
     damping: (f64, f64),
     /// The welded cloth's model, built with the scene; taken at the weld.
     welded: Option<Model>,
-    /// For each vertex of the unsewn cloth, its vertex in the welded one.
-    weld_map: Vec<u32>,
     /// Vertices pinned once the garment is sewn (attached ones), unsewn numbering.
     pin_after: Vec<u32>,
     /// Each seam's vertex pairs (unsewn numbering), and whether it has been open (a pair
@@ -108,9 +106,9 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
     let x = garment.positions.clone();
     let (welded_surface, weld_map) = weld_surface(&garment.surface, &pairs);
     let closed_gap = g.closed_share * thickness;
-    let open: Vec<bool> = garment.seams.iter().map(|seam| seam.iter().any(|&[a, b]| x[a as usize].distance(x[b as usize]) > closed_gap)).collect();
+    let open = still_open(&garment.seams, &vec![true; garment.seams.len()], &x, closed_gap);
     model.sewing.bands = crate::sim::model::seam_bands(&garment.seams, &open, &model.triangles, x.len());
-    model.sewing.welded = weld_map.clone();
+    model.sewing.welded = weld_map;
     if config.contact.self_collision {
         check_uncrossed(&garment, &model)?;
         check_apart(&garment, &model, config.contact.self_thickness_for(model.mean_edge_length))?;
@@ -135,7 +133,6 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
         closed_gap,
         damping: (g.sewing_damping, config.solver.damping),
         welded: Some(welded),
-        weld_map,
         pin_after,
         seams: garment.seams.clone(),
         open,
@@ -149,6 +146,12 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
 /// How long the sewing springs take to double their stiffness once the sewing's
 /// schedule has run out with a seam still open, s.
 const STIFFEN_DOUBLING: f64 = 0.05;
+
+/// Which seams are open at `x` (a pair farther apart than `closed_gap`) among those that
+/// have been (`was_open`): a seam that has closed counts as closed from then on.
+fn still_open(seams: &[Vec<[u32; 2]>], was_open: &[bool], x: &[DVec3], closed_gap: f64) -> Vec<bool> {
+    seams.iter().zip(was_open).map(|(seam, &open)| open && seam.iter().any(|&[a, b]| x[a as usize].distance(x[b as usize]) > closed_gap)).collect()
+}
 
 /// Refuses a panel that starts inside the form (or within its contact layer).
 fn check_outside(garment: &Garment, form: &Prop, thickness: f64) -> Result<(), SceneError> {
@@ -337,7 +340,7 @@ impl Scene {
         // drew it 17 mm open, and its two fronts, left out there, folded through each other
         // in 20 places.
         let x = &self.state.x;
-        let open: Vec<bool> = sewing.seams.iter().zip(&sewing.open).map(|(seam, &open)| open && seam.iter().any(|&[a, b]| x[a as usize].distance(x[b as usize]) > sewing.closed_gap)).collect();
+        let open = still_open(&sewing.seams, &sewing.open, x, sewing.closed_gap);
         if open != sewing.open {
             self.model.sewing.bands = crate::sim::model::seam_bands(&sewing.seams, &open, &self.model.triangles, x.len());
             sewing.open = open;
@@ -366,9 +369,11 @@ impl Scene {
             return;
         }
         let mut model = sewing.welded.take().expect("the welded model waits until the weld");
+        // For each vertex of the unsewn cloth, its vertex in the welded one.
+        let weld_map = &self.model.sewing.welded;
         let n = model.vertex_count();
         let (mut mass, mut position, mut velocity) = (vec![0.0; n], vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-        for (v, &w) in sewing.weld_map.iter().enumerate() {
+        for (v, &w) in weld_map.iter().enumerate() {
             let m = self.model.mass[v];
             mass[w as usize] += m;
             position[w as usize] += m * x[v];
@@ -379,7 +384,7 @@ impl Scene {
             velocity[w] /= mass[w];
         }
         for v in self.model.fixed.iter().enumerate().filter(|(_, f)| **f).map(|(v, _)| v as u32).chain(sewing.pin_after.iter().copied()) {
-            let w = sewing.weld_map[v as usize];
+            let w = weld_map[v as usize];
             model.pin(w, position[w as usize]);
         }
         model.options = self.model.options;
@@ -393,7 +398,7 @@ impl Scene {
         sewing.sewn_at = Some(self.state.time);
         sewing.gap_at_weld = Some(gap);
         if let super::rigs::Rig::Garment(rig) = &mut self.rig {
-            rig.welded(&sewing.weld_map, self.state.time, gap);
+            rig.welded(weld_map, self.state.time, gap);
         }
         self.model = model;
         self.state = state;
