@@ -15,6 +15,42 @@ use crate::settings::SceneConfig;
 use super::{Measures, Metrics, Scene};
 use crate::io::number::short;
 
+/// Below this share of critical damping, an unsettled run suggests damping its swing harder.
+const UNDERDAMPED_SHARE: f64 = 0.8;
+
+/// For a cloth that hangs (its height more than a few contact layers) with less air damping
+/// than damps its swing critically: the damping that would, and why it leaves the rest
+/// state alone. Empty otherwise. The swing is the hanging chain's first mode over the
+/// cloth's height L (docs/references.md §10), ω = (j₀,₁/2)·√(g/L), and drag −ζ·m·v damps it
+/// critically at ζ = 2ω: about 10/s for a 55 cm skirt. Damping does not move an
+/// equilibrium, only how soon the swing about it dies out (docs/garments.md).
+fn swing_damping_hint(scene: &Scene) -> String {
+    let (low, high) = scene.state.x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.z), hi.max(p.z)));
+    let height = high - low;
+    if !height.is_finite() || height <= 5.0 * scene.config.contact.thickness {
+        return String::new();
+    }
+    let critical = critical_swing_damping(height);
+    let damping = scene.config.solver.damping;
+    if damping >= UNDERDAMPED_SHARE * critical {
+        return String::new();
+    }
+    format!(
+        ", or damp its swing harder: hanging {} cm, it swings at {} rad/s, which solver.damping = {} 1/s damps critically \
+         (it is {} 1/s; more than that slows the folds' creep, and no damping moves the equilibrium the cloth swings about)",
+        short(100.0 * height),
+        short(0.5 * critical),
+        short(critical.round()),
+        short(damping)
+    )
+}
+
+/// The air damping ζ (1/s) that damps the swing of a cloth hanging `height` (m) critically:
+/// 2ω for the hanging chain's first mode, 2 · 2π/T = j₀,₁ √(g/L).
+fn critical_swing_damping(height: f64) -> f64 {
+    crate::reference::J0_FIRST_ZERO * (crate::physics::STANDARD_GRAVITY / height).sqrt()
+}
+
 /// Refuses props that start through the cloth: a vertex inside a prop, or an edge that
 /// passes through one. Contact would push such a cloth out violently (or hold it threaded
 /// on the prop), a start no laboratory has.
@@ -130,11 +166,12 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
     if let (Some(false), true, None, Some(limit)) = (metrics.settled, metrics.stable, &metrics.stopped_at_limit, config.scene.settle_speed) {
         metrics.notes.push(format!(
             "not settled: at {} s the cloth still moved at {} mm/s RMS (scene.settle_speed = {} mm/s, held for scene.settle_window = {} s), \
-             so its measures are of a cloth in motion; run longer (--duration, or scene.duration)",
+             so its measures are of a cloth in motion; run longer (--duration, or scene.duration){}",
             short(scene.state.time),
             short(1e3 * scene.rms_speed()),
             short(1e3 * limit),
-            short(config.scene.settle_window)
+            short(config.scene.settle_window),
+            swing_damping_hint(scene)
         ));
     }
     let end = scene.state.time;
@@ -160,7 +197,13 @@ mod tests {
     /// real crossing needs a long run; `a_crossed_arrangement_is_refused_before_the_run`
     /// covers the start) and the notes judged again.
     fn notes_with_crossings(self_collision: bool, count: usize) -> Vec<String> {
-        let overrides = ["mesh.edge_length=0.05".to_string(), format!("contact.self_collision={self_collision}")];
+        notes_after_a_step(&[format!("contact.self_collision={self_collision}")], count)
+    }
+
+    /// The notes of the coarse straight skirt (with `overrides`) after one step, judged
+    /// as if it had ended with `count` self-intersections.
+    fn notes_after_a_step(overrides: &[String], count: usize) -> Vec<String> {
+        let overrides: Vec<String> = std::iter::once("mesh.edge_length=0.05".to_string()).chain(overrides.iter().cloned()).collect();
         let (config, _) = crate::scene::load_scene("skirt-gored-straight", &overrides).unwrap();
         let mut scene = Scene::build(config).unwrap();
         let (mut metrics, _) = crate::scene::run_scene(&mut scene, "crossed", crate::scene::RunOptions { duration: Some(0.004), ..Default::default() });
@@ -168,6 +211,13 @@ mod tests {
         metrics.notes.clear();
         judge(&scene, &mut metrics, 0.004);
         metrics.notes
+    }
+
+    /// A 55 cm skirt's swing: the hanging chain's first mode, ω = (2.404826/2)·√(9.80665/0.55)
+    /// = 5.0773 rad/s, damped critically by drag ζ = 2ω = 10.155/s (worked by hand).
+    #[test]
+    fn a_hanging_cloths_swing_is_damped_critically_at_twice_its_frequency() {
+        assert!((critical_swing_damping(0.55) - 10.155).abs() < 1e-3, "{}", critical_swing_damping(0.55));
     }
 
     /// A cloth that ends through itself with self-collision on is said to, and for a
@@ -189,6 +239,13 @@ mod tests {
         let notes = notes_with_crossings(true, 0);
         let note = notes.iter().find(|n| n.starts_with("not settled")).unwrap_or_else(|| panic!("{notes:?}"));
         assert!(note.contains("scene.settle_speed = 1 mm/s") && note.contains("--duration"), "{note}");
+        // The skirt hangs from the form at its bundled 4/s, under half of what damps its
+        // swing critically.
+        assert!(note.contains("solver.damping = ") && note.contains("(it is 4 1/s"), "{note}");
+        // Past critical damping (about 10/s for its 53 cm) nothing more is suggested.
+        let damped = notes_after_a_step(&["solver.damping=30".to_string()], 0);
+        let note = damped.iter().find(|n| n.starts_with("not settled")).unwrap_or_else(|| panic!("{damped:?}"));
+        assert!(!note.contains("solver.damping"), "{note}");
         let (config, _) = crate::scene::load_scene("tensile-warp", &[]).unwrap();
         let mut scene = Scene::build(config).unwrap();
         let (metrics, _) = crate::scene::run_scene(&mut scene, "tensile", crate::scene::RunOptions { duration: Some(0.002), ..Default::default() });
