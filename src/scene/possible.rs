@@ -19,11 +19,9 @@ use crate::io::number::short;
 const UNDERDAMPED_SHARE: f64 = 0.8;
 
 /// For a cloth that hangs (its height more than a few contact layers) with less air damping
-/// than damps its swing critically: the damping that would, and why it leaves the rest
-/// state alone. Empty otherwise. The swing is the hanging chain's first mode over the
-/// cloth's height L (docs/references.md §10), ω = (j₀,₁/2)·√(g/L), and drag −ζ·m·v damps it
-/// critically at ζ = 2ω: about 10/s for a 55 cm skirt. Damping does not move an
-/// equilibrium, only how soon the swing about it dies out (docs/garments.md).
+/// than [`critical_swing_damping`] for its height: that damping, and why it leaves the
+/// rest state alone (damping does not move an equilibrium, only how soon the swing about it
+/// dies out; docs/garments.md). Empty otherwise.
 fn swing_damping_hint(scene: &Scene) -> String {
     let (low, high) = scene.state.x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.z), hi.max(p.z)));
     let height = high - low;
@@ -46,7 +44,8 @@ fn swing_damping_hint(scene: &Scene) -> String {
 }
 
 /// The air damping ζ (1/s) that damps the swing of a cloth hanging `height` (m) critically:
-/// 2ω for the hanging chain's first mode, 2 · 2π/T = j₀,₁ √(g/L).
+/// drag −ζ·m·v on the hanging chain's first mode (docs/references.md §10),
+/// ω = (j₀,₁/2)·√(g/L), is critical at ζ = 2ω = j₀,₁ √(g/L), about 10/s for a 55 cm skirt.
 fn critical_swing_damping(height: f64) -> f64 {
     crate::reference::J0_FIRST_ZERO * (crate::physics::STANDARD_GRAVITY / height).sqrt()
 }
