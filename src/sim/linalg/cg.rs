@@ -5,6 +5,7 @@ use super::storage::PARALLEL_ROWS;
 use super::system::SystemMatrix;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Outcome of a conjugate-gradient solve.
 #[derive(Debug, Clone, Copy)]
@@ -91,7 +92,7 @@ pub fn pcg_deflated(
     let deflation = recycled.and_then(|recycled| Deflation::new(a, recycled));
     let mut residual = 1.0;
     if let Some(d) = &deflation {
-        let c = d.galerkin(&d.w, &r);
+        let c = d.galerkin(&r);
         d.add(&d.w, &c, x, 1.0);
         d.add(&d.aw, &c, &mut r, -1.0);
         residual = dot(&r, &r).sqrt() / b_norm;
@@ -101,49 +102,137 @@ pub fn pcg_deflated(
     }
     let mut z = vec![DVec3::ZERO; n];
     preconditioner.apply(&r, &mut z);
-    let mut p = z.clone();
-    if let Some(d) = &deflation {
-        d.remove(&z, &mut p);
-    }
+    let mut p = vec![DVec3::ZERO; n];
+    let mut rz = next_direction(&r, &z, &mut p, None, deflation.as_ref());
     let mut ap = vec![DVec3::ZERO; n];
-    let mut rz = dot(&r, &z);
     let mut iterations = 0;
     let mut negative_curvature = false;
     while iterations < max_iterations {
         a.apply(&p, &mut ap);
-        let pap = dot(&p, &ap);
+        let pap = in_order(n, |rows| dot(&p[rows.clone()], &ap[rows])).iter().sum::<f64>();
         if pap <= 0.0 || !pap.is_finite() {
             // (A direction deflated to nothing is no curvature: the solve has stalled.)
             negative_curvature = !(pap == 0.0 && dot(&p, &p) == 0.0);
             break;
         }
         let alpha = rz / pap;
-        for i in 0..n {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * ap[i];
-        }
+        // x += αp and r −= αAp, with |r|² in the same pass.
+        let rr = in_order_mut(x, &mut r, |rows, x, r| {
+            let mut rr = 0.0;
+            for (((x, r), p), ap) in x.iter_mut().zip(r.iter_mut()).zip(&p[rows.clone()]).zip(&ap[rows]) {
+                *x += alpha * *p;
+                *r -= alpha * *ap;
+                rr += r.length_squared();
+            }
+            rr
+        })
+        .iter()
+        .sum::<f64>();
         iterations += 1;
-        residual = dot(&r, &r).sqrt() / b_norm;
+        residual = rr.sqrt() / b_norm;
         if residual <= tolerance {
             break;
         }
         preconditioner.apply(&r, &mut z);
-        let rz_next = dot(&r, &z);
-        let beta = rz_next / rz;
-        rz = rz_next;
-        for i in 0..n {
-            p[i] = z[i] + beta * p[i];
-        }
-        if let Some(d) = &deflation {
-            d.remove(&z, &mut p);
-        }
+        rz = next_direction(&r, &z, &mut p, Some(rz), deflation.as_ref());
     }
     CgReport { iterations, relative_residual: residual, negative_curvature }
 }
 
+/// The next search direction p = z + β p − W (WᵀAW)⁻¹ (AW)ᵀ z = z + β p − V (AV)ᵀ z, with β = 0 for the first
+/// and r·z over `rz_before` (the last r·z) after it, W empty without deflation; returns r·z.
+/// Two passes over the vectors: one for r·z and (AW)ᵀz together, one for p.
+///
+/// Fused by hand: apart, the dot product, the direction and the deflation's projection read
+/// z three times and p twice, the first two on one thread. On the 10k bias skirt the
+/// passes besides the product and the factor's solves took 0.18 ms an iteration apart and
+/// 0.14 ms fused (docs/performance-log.md, "2026-12-06").
+fn next_direction(r: &[DVec3], z: &[DVec3], p: &mut [DVec3], rz_before: Option<f64>, deflation: Option<&Deflation>) -> f64 {
+    let m = deflation.map_or(0, |d| d.m);
+    // Entry 0: r·z; entries 1..=m: (AV)ᵀz, the weights of V's columns in p (VᵀAV = I).
+    let partials = in_order(r.len(), |rows| {
+        let mut sums = vec![0.0; 1 + m];
+        sums[0] = dot(&r[rows.clone()], &z[rows.clone()]);
+        if let Some(d) = deflation {
+            for (mr, zi) in d.av32[rows.start * m..rows.end * m].chunks(m).zip(&z[rows]) {
+                for (s, mj) in sums[1..].iter_mut().zip(mr) {
+                    *s += mj.as_dvec3().dot(*zi);
+                }
+            }
+        }
+        sums
+    });
+    let sums = add_up(1 + m, partials);
+    let (rz, c) = (sums[0], &sums[1..]);
+    let beta = rz_before.map_or(0.0, |before| rz / before);
+    in_order_mut(p, &mut [], |rows, p, _| {
+        let zs = &z[rows.clone()];
+        match deflation {
+            Some(d) => {
+                for ((p, z), vr) in p.iter_mut().zip(zs).zip(d.v32[rows.start * m..rows.end * m].chunks(m)) {
+                    let projected = vr.iter().zip(c).fold(DVec3::ZERO, |acc, (vj, &cj)| acc + cj * vj.as_dvec3());
+                    *p = *z + beta * *p - projected;
+                }
+            }
+            None => {
+                for (p, z) in p.iter_mut().zip(zs) {
+                    *p = *z + beta * *p;
+                }
+            }
+        }
+    });
+    rz
+}
+
+/// The least pivot of WᵀAW's Cholesky factor, as a share of its diagonal entry, for which a
+/// recycled column is kept. Near rest a run's last Newton directions nearly repeat: on the
+/// 10k straight skirt the pivots fell to 1e-8 of the diagonal, and every such solve (10 in
+/// the run) ran to CG's limit of 3 000 iterations, its residual growing to 10⁴ times the
+/// right-hand side's, 35 % of the run's iterations (docs/performance-log.md, "2026-12-06").
+/// Deflated CG in this form is known to be unstable under an inexact projection, and a
+/// space that nearly repeats makes it inexact in any precision: in double precision
+/// throughout, a test space with pivots of 1e-7 (`deflated_cg_converges_with_nearly_
+/// repeated_directions`) still diverged. A column that adds under a hundredth of its
+/// A-norm to the span is worth little to deflate by.
+const LEAST_PIVOT: f64 = 1e-4;
+
+/// Rows per chunk of the solve's passes: as for the products, small enough that two threads
+/// share a 10k garment's rows evenly.
+const CHUNK: usize = 256;
+
+/// `f(rows)` for the chunks of [`CHUNK`] rows of `0..n`, over rayon's pool when `n` is long,
+/// the results in chunk order: partial sums added in that order are the same on any number
+/// of threads.
+fn in_order<T: Send>(n: usize, f: impl Fn(Range<usize>) -> T + Sync) -> Vec<T> {
+    let rows = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(n);
+    if n < PARALLEL_ROWS {
+        (0..n.div_ceil(CHUNK)).map(|c| f(rows(c))).collect()
+    } else {
+        (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| f(rows(c))).collect()
+    }
+}
+
+/// As [`in_order`], with the chunks of `a` and of `b` (of `a`'s length, or empty for none)
+/// to write: `f(rows, &mut a[rows], &mut b[rows])`.
+fn in_order_mut<T: Send>(a: &mut [DVec3], b: &mut [DVec3], f: impl Fn(Range<usize>, &mut [DVec3], &mut [DVec3]) -> T + Sync) -> Vec<T> {
+    let n = a.len();
+    let rows = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(n);
+    if b.is_empty() {
+        if n < PARALLEL_ROWS {
+            a.chunks_mut(CHUNK).enumerate().map(|(c, a)| f(rows(c), a, &mut [])).collect()
+        } else {
+            a.par_chunks_mut(CHUNK).enumerate().map(|(c, a)| f(rows(c), a, &mut [])).collect()
+        }
+    } else if n < PARALLEL_ROWS {
+        a.chunks_mut(CHUNK).zip(b.chunks_mut(CHUNK)).enumerate().map(|(c, (a, b))| f(rows(c), a, b)).collect()
+    } else {
+        a.par_chunks_mut(CHUNK).zip(b.par_chunks_mut(CHUNK)).enumerate().map(|(c, (a, b))| f(rows(c), a, b)).collect()
+    }
+}
+
 /// The deflation space of one solve: W and AW, their k columns side by side (`w[i * k + j]`
-/// is vertex i of column j: a pass over all k reads memory in order), and the Cholesky
-/// factor of WᵀAW.
+/// is vertex i of column j: a pass over all k reads memory in order), the Cholesky factor of
+/// WᵀAW, and an A-orthonormal basis of the same span for the passes of every iteration.
 ///
 /// Written by hand: k is at most a handful, and the passes are fused over the mesh's
 /// vertices, which no dense-algebra crate's k×k routines would do for us.
@@ -151,14 +240,20 @@ struct Deflation {
     k: usize,
     w: Vec<DVec3>,
     aw: Vec<DVec3>,
-    /// W and AW in single precision, for the passes of every iteration (bound by reading
-    /// them; the projection needs no more digits than the incomplete factor keeps).
-    w32: Vec<Vec3>,
-    aw32: Vec<Vec3>,
-    /// L of WᵀAW = LLᵀ by rows (k×k); a column whose pivot is not clearly positive (A not
-    /// positive along it, or it nearly lies in the span of the columns before it) is left
-    /// out: its row and column of L are zero and it gets no weight.
+    /// L of WᵀAW = LLᵀ by rows (k×k). A column whose pivot is under [`LEAST_PIVOT`] of its
+    /// diagonal entry (A not positive along it, or it nearly lies in the span of the
+    /// columns before it) is left out: its row and column of L are zero and it gets no
+    /// weight.
     factor: Vec<f64>,
+    /// The columns kept, m.
+    m: usize,
+    /// V = W L⁻ᵀ over the kept columns (VᵀAV = I) and AV, m side by side, in single
+    /// precision: the passes of every iteration are bound by reading them, and the
+    /// projection needs no more digits than the incomplete factor keeps. Orthonormal, so
+    /// that the projection's weights are (AV)ᵀz themselves, not rounding errors multiplied
+    /// by (WᵀAW)⁻¹.
+    v32: Vec<Vec3>,
+    av32: Vec<Vec3>,
 }
 
 impl Deflation {
@@ -170,71 +265,96 @@ impl Deflation {
             return None;
         }
         let mut w = vec![DVec3::ZERO; n * k];
-        for (i, row) in w.chunks_mut(k).enumerate() {
-            if !a.fixed[i] {
-                for (out, column) in row.iter_mut().zip(&columns) {
-                    *out = column[i];
+        w.par_chunks_mut(k * CHUNK).enumerate().for_each(|(c, rows)| {
+            for (i, row) in (c * CHUNK..).zip(rows.chunks_mut(k)) {
+                if !a.fixed[i] {
+                    for (out, column) in row.iter_mut().zip(&columns) {
+                        *out = column[i];
+                    }
                 }
             }
-        }
+        });
         let mut aw = vec![DVec3::ZERO; n * k];
         a.apply_many(k, &w, &mut aw);
         // G = WᵀAW, symmetrised.
-        let mut g = vec![0.0; k * k];
-        for (wr, ar) in w.chunks(k).zip(aw.chunks(k)) {
-            for p in 0..k {
-                for q in 0..=p {
-                    g[p * k + q] += wr[p].dot(ar[q]) + wr[q].dot(ar[p]);
+        let g = add_up(
+            k * k,
+            in_order(n, |rows| {
+                let mut g = vec![0.0; k * k];
+                for (wr, ar) in w[rows.start * k..rows.end * k].chunks(k).zip(aw[rows.start * k..rows.end * k].chunks(k)) {
+                    for (p, wp) in wr.iter().enumerate() {
+                        for (q, aq) in ar.iter().enumerate() {
+                            g[p * k + q] += wp.dot(*aq);
+                        }
+                    }
                 }
-            }
-        }
+                g
+            }),
+        );
+        let gram = |i: usize, j: usize| 0.5 * (g[i * k + j] + g[j * k + i]);
         let mut factor = vec![0.0_f64; k * k];
         let mut kept = 0;
         for j in 0..k {
-            let diagonal = 0.5 * g[j * k + j];
+            let diagonal = gram(j, j);
             let pivot = diagonal - (0..j).map(|l| factor[j * k + l].powi(2)).sum::<f64>();
-            if !(diagonal > 0.0 && pivot > 1e-8 * diagonal && pivot.is_finite()) {
+            if !(diagonal > 0.0 && pivot > LEAST_PIVOT * diagonal && pivot.is_finite()) {
                 continue;
             }
             let root = pivot.sqrt();
             factor[j * k + j] = root;
             for i in j + 1..k {
-                let gij = 0.5 * g[i * k + j];
-                factor[i * k + j] = (gij - (0..j).map(|l| factor[i * k + l] * factor[j * k + l]).sum::<f64>()) / root;
+                factor[i * k + j] = (gram(i, j) - (0..j).map(|l| factor[i * k + l] * factor[j * k + l]).sum::<f64>()) / root;
             }
             kept += 1;
         }
-        let w32 = w.iter().map(|v| v.as_vec3()).collect();
-        let aw32 = aw.iter().map(|v| v.as_vec3()).collect();
-        (kept > 0).then_some(Self { k, w, aw, w32, aw32, factor })
+        if kept == 0 {
+            return None;
+        }
+        // L⁻¹ over the kept columns (m×m, lower, by rows), by forward substitution: V's
+        // column q is Σ_{p≤q} L⁻¹[q][p] W's kept column p.
+        let columns: Vec<usize> = (0..k).filter(|&j| factor[j * k + j] > 0.0).collect();
+        let m = columns.len();
+        let l = |a: usize, b: usize| factor[columns[a] * k + columns[b]];
+        let mut inverse = vec![0.0; m * m];
+        for q in 0..m {
+            inverse[q * m + q] = 1.0 / l(q, q);
+            for p in 0..q {
+                inverse[q * m + p] = -(p..q).map(|s| l(q, s) * inverse[s * m + p]).sum::<f64>() / l(q, q);
+            }
+        }
+        let orthonormal = |from: &[DVec3]| -> Vec<Vec3> {
+            let mut to = vec![Vec3::ZERO; n * m];
+            to.par_chunks_mut(m * CHUNK).zip(from.par_chunks(k * CHUNK)).for_each(|(to, from)| {
+                for (to, from) in to.chunks_mut(m).zip(from.chunks(k)) {
+                    for (q, out) in to.iter_mut().enumerate() {
+                        *out = (0..=q).fold(DVec3::ZERO, |acc, p| acc + inverse[q * m + p] * from[columns[p]]).as_vec3();
+                    }
+                }
+            });
+            to
+        };
+        let (v32, av32) = (orthonormal(&w), orthonormal(&aw));
+        Some(Self { k, w, aw, factor, m, v32, av32 })
     }
 
-    /// (WᵀAW)⁻¹ Mᵀv for M = W or AW: the k products in one pass over v, then the two
-    /// triangular solves with L, columns left out getting zero.
-    fn galerkin<T: Column>(&self, m: &[T], v: &[DVec3]) -> Vec<f64> {
+    /// (WᵀAW)⁻¹ Wᵀv: the k products in one pass over v, then [`Self::solve_gram`].
+    fn galerkin(&self, v: &[DVec3]) -> Vec<f64> {
         let k = self.k;
-        // Partial sums by fixed chunks of vertices, added in order: the same result on any
-        // number of threads.
-        let partial = |(mc, vc): (&[T], &[DVec3])| {
+        let partials = in_order(v.len(), |rows| {
             let mut c = vec![0.0; k];
-            for (mr, vi) in mc.chunks(k).zip(vc) {
-                for (cj, mj) in c.iter_mut().zip(mr) {
-                    *cj += mj.wide().dot(*vi);
+            for (wr, vi) in self.w[rows.start * k..rows.end * k].chunks(k).zip(&v[rows]) {
+                for (cj, wj) in c.iter_mut().zip(wr) {
+                    *cj += wj.dot(*vi);
                 }
             }
             c
-        };
-        let partials: Vec<Vec<f64>> = if v.len() < PARALLEL_ROWS {
-            m.chunks(k * CHUNK).zip(v.chunks(CHUNK)).map(partial).collect()
-        } else {
-            m.par_chunks(k * CHUNK).zip(v.par_chunks(CHUNK)).map(partial).collect()
-        };
-        let mut c = vec![0.0; k];
-        for part in &partials {
-            for (cj, pj) in c.iter_mut().zip(part) {
-                *cj += pj;
-            }
-        }
+        });
+        self.solve_gram(add_up(k, partials))
+    }
+
+    /// (WᵀAW)⁻¹ c by the two triangular solves with L, columns left out getting zero.
+    fn solve_gram(&self, mut c: Vec<f64>) -> Vec<f64> {
+        let k = self.k;
         let l = |i: usize, j: usize| self.factor[i * k + j];
         for i in 0..k {
             c[i] = if l(i, i) > 0.0 { (c[i] - (0..i).map(|j| l(i, j) * c[j]).sum::<f64>()) / l(i, i) } else { 0.0 };
@@ -245,47 +365,24 @@ impl Deflation {
         c
     }
 
-    /// v += sign · M c.
-    fn add<T: Column>(&self, m: &[T], c: &[f64], v: &mut [DVec3], sign: f64) {
+    /// v += sign · M c for M = W or AW (in double precision).
+    fn add(&self, m: &[DVec3], c: &[f64], v: &mut [DVec3], sign: f64) {
         let k = self.k;
-        let pass = |(vc, mc): (&mut [DVec3], &[T])| {
-            for (vi, mr) in vc.iter_mut().zip(mc.chunks(k)) {
-                *vi += sign * mr.iter().zip(c).fold(DVec3::ZERO, |acc, (mj, &cj)| acc + cj * mj.wide());
+        in_order_mut(v, &mut [], |rows, v, _| {
+            for (vi, mr) in v.iter_mut().zip(m[rows.start * k..rows.end * k].chunks(k)) {
+                *vi += sign * mr.iter().zip(c).fold(DVec3::ZERO, |acc, (mj, &cj)| acc + cj * *mj);
             }
-        };
-        if v.len() < PARALLEL_ROWS {
-            v.chunks_mut(CHUNK).zip(m.chunks(k * CHUNK)).for_each(pass);
-        } else {
-            v.par_chunks_mut(CHUNK).zip(m.par_chunks(k * CHUNK)).for_each(pass);
+        });
+    }
+}
+
+/// The sum, entry by entry, of `width`-long partial sums, in their order.
+fn add_up(width: usize, partials: Vec<Vec<f64>>) -> Vec<f64> {
+    let mut sums = vec![0.0; width];
+    for part in &partials {
+        for (s, q) in sums.iter_mut().zip(part) {
+            *s += q;
         }
     }
-
-    /// p −= W (WᵀAW)⁻¹ (AW)ᵀ z: the part of z that is not A-orthogonal to W taken out of
-    /// the search direction p built from it.
-    fn remove(&self, z: &[DVec3], p: &mut [DVec3]) {
-        let c = self.galerkin(&self.aw32, z);
-        self.add(&self.w32, &c, p, -1.0);
-    }
-}
-
-/// Vertices per chunk of the deflation's passes.
-const CHUNK: usize = 512;
-
-/// A column entry in double or single precision.
-trait Column: Sync {
-    fn wide(&self) -> DVec3;
-}
-
-impl Column for DVec3 {
-    #[inline]
-    fn wide(&self) -> DVec3 {
-        *self
-    }
-}
-
-impl Column for Vec3 {
-    #[inline]
-    fn wide(&self) -> DVec3 {
-        self.as_dvec3()
-    }
+    sums
 }
