@@ -139,9 +139,10 @@ pub fn pcg_deflated(
     CgReport { iterations, relative_residual: residual, negative_curvature }
 }
 
-/// The next search direction p = z + β p − W (WᵀAW)⁻¹ (AW)ᵀ z = z + β p − V (AV)ᵀ z, with β = 0 for the first
-/// and r·z over `rz_before` (the last r·z) after it, W empty without deflation; returns r·z.
-/// Two passes over the vectors: one for r·z and (AW)ᵀz together, one for p.
+/// The next search direction p = z + β p − W (WᵀAW)⁻¹ (AW)ᵀ z = z + β p − V (AV)ᵀ z, with
+/// β = 0 for the first and r·z over `rz_before` (the last r·z) after it, V empty without
+/// deflation; returns r·z. Two passes over the vectors: one for r·z and (AV)ᵀz together,
+/// one for p.
 ///
 /// Fused by hand: apart, the dot product, the direction and the deflation's projection read
 /// z three times and p twice, the first two on one thread. On the 10k bias skirt the
@@ -312,9 +313,9 @@ impl Deflation {
         }
         // L⁻¹ over the kept columns (m×m, lower, by rows), by forward substitution: V's
         // column q is Σ_{p≤q} L⁻¹[q][p] W's kept column p.
-        let columns: Vec<usize> = (0..k).filter(|&j| factor[j * k + j] > 0.0).collect();
-        let m = columns.len();
-        let l = |a: usize, b: usize| factor[columns[a] * k + columns[b]];
+        let basis: Vec<usize> = (0..k).filter(|&j| factor[j * k + j] > 0.0).collect();
+        let m = basis.len();
+        let l = |a: usize, b: usize| factor[basis[a] * k + basis[b]];
         let mut inverse = vec![0.0; m * m];
         for q in 0..m {
             inverse[q * m + q] = 1.0 / l(q, q);
@@ -327,7 +328,7 @@ impl Deflation {
             to.par_chunks_mut(m * CHUNK).zip(from.par_chunks(k * CHUNK)).for_each(|(to, from)| {
                 for (to, from) in to.chunks_mut(m).zip(from.chunks(k)) {
                     for (q, out) in to.iter_mut().enumerate() {
-                        *out = (0..=q).fold(DVec3::ZERO, |acc, p| acc + inverse[q * m + p] * from[columns[p]]).as_vec3();
+                        *out = (0..=q).fold(DVec3::ZERO, |acc, p| acc + inverse[q * m + p] * from[basis[p]]).as_vec3();
                     }
                 }
             });
