@@ -294,7 +294,6 @@ impl Deflation {
         );
         let gram = |i: usize, j: usize| 0.5 * (g[i * k + j] + g[j * k + i]);
         let mut factor = vec![0.0_f64; k * k];
-        let mut kept = 0;
         for j in 0..k {
             let diagonal = gram(j, j);
             let pivot = diagonal - (0..j).map(|l| factor[j * k + l].powi(2)).sum::<f64>();
@@ -306,15 +305,14 @@ impl Deflation {
             for i in j + 1..k {
                 factor[i * k + j] = (gram(i, j) - (0..j).map(|l| factor[i * k + l] * factor[j * k + l]).sum::<f64>()) / root;
             }
-            kept += 1;
         }
-        if kept == 0 {
+        let basis: Vec<usize> = (0..k).filter(|&j| factor[j * k + j] > 0.0).collect();
+        let m = basis.len();
+        if m == 0 {
             return None;
         }
         // L⁻¹ over the kept columns (m×m, lower, by rows), by forward substitution: V's
         // column q is Σ_{p≤q} L⁻¹[q][p] W's kept column p.
-        let basis: Vec<usize> = (0..k).filter(|&j| factor[j * k + j] > 0.0).collect();
-        let m = basis.len();
         let l = |a: usize, b: usize| factor[basis[a] * k + basis[b]];
         let mut inverse = vec![0.0; m * m];
         for q in 0..m {
