@@ -74,6 +74,57 @@ fn bad_patterns_are_refused_naming_the_panel_and_the_edge() {
     }
 }
 
+/// What a pattern file can get wrong beyond the cases above, each refused before any step
+/// (when the file is read or the scene is built) with a message that names the key, the
+/// panel or the edge, and says what would fix it.
+#[test]
+fn malformed_outlines_seams_and_forms_are_refused_naming_their_key() {
+    let gored = bundled("skirt-gored-straight");
+    let outline = "edges = [\n  { name = \"hem\", to = [20, 0], through = [0, -2.0157] },\n  { name = \"right\", to = [8.8, 55] },\n  { name = \"waist\", to = [-8.8, 55], through = [0, 54.1131] },\n  { name = \"left\", to = [-20, 0] },\n]";
+    let clockwise = "edges = [\n  { name = \"left\", to = [-8.8, 55] },\n  { name = \"waist\", to = [8.8, 55], through = [0, 54.1131] },\n  { name = \"right\", to = [20, 0] },\n  { name = \"hem\", to = [-20, 0], through = [0, -2.0157] },\n]";
+    let hem = "{ name = \"hem\", to = [20, 0], through = [0, -2.0157] }";
+    let last = "{ name = \"left\", to = [-20, 0] },\n]";
+    let cases: [(&str, &str, &[&str]); 21] = [
+        // Outlines.
+        (outline, clockwise, &["'front'", "runs clockwise", "counter-clockwise"]),
+        (last, "{ name = \"left\", to = [-20, 1] },\n]", &["'front'", "'left' must end at start"]),
+        (last, "{ name = \"left\", to = [-20, 0] },\n  { name = \"extra\", to = [-20, 0] },\n]", &["'front'", "edge 'extra' has no length"]),
+        (last, "{ name = \"hem\", to = [-20, 0] },\n]", &["'front'", "two edges are named 'hem'"]),
+        (hem, "{ name = \"hem\", to = [20, 0], through = [0, -2], controls = [[6, -2], [-6, -2]] }", &["'front'", "edge 'hem'", "keep one"]),
+        (hem, "{ name = \"hem\", to = [20, 0], through = [0, 0] }", &["'front'", "edge 'hem'", "lie on a line"]),
+        (hem, "{ name = \"hem\", to = [20, 0], controls = [[nan, -20], [-60, -20]] }", &["'front'", "edge 'hem'", "finite coordinates"]),
+        (hem, "{ name = \"hem\", to = [20, 0], controls = [[60, -20], [-60, -20]] }", &["'front'", "crosses itself", "'hem'"]),
+        // Panels and their placement.
+        ("name = \"right\"\ngrain_deg", "name = \"front\"\ngrain_deg", &["two panels are named 'front'"]),
+        ("flare_deg = 14.82", "flare_deg = 200", &["'front'", "flare_deg between 0 and 90"]),
+        ("around = \"cone\"", "around = \"sphere\"", &["placement.around", "expected `cone` or `plane`"]),
+        // Seams, hem and attachments.
+        ("direction = \"opposite\"\n", "direction = \"opposite\"\na_span = [0.8, 0.2]\n", &["garment.seams[0].a_span", "increasing stretch"]),
+        ("units = \"cm\"", "units = \"cm\"\nhem = [\"front.nothem\"]", &["garment.hem", "no edge 'nothem'", "hem, right, waist, left"]),
+        ("sewing_time = 1.0", "sewing_time = 1.0\n\n[[garment.attachments]]\nedge = \"front.nowaist\"\npin = true", &["garment.attachments[0].edge", "no edge 'nowaist'"]),
+        ("sewing_time = 1.0", "sewing_time = 1.0\n\n[[garment.attachments]]\nedge = \"front.waist\"\nlevel = \"knee\"", &["garment.attachments[0].level", "waist, hip or bust"]),
+        ("units = \"cm\"", "units = \"cm\"\nseam_ease = -0.5", &["garment.seam_ease = -0.5", "between 0 and 0.5"]),
+        ("sewing_time = 1.0", "sewing_time = -1.0", &["garment.sewing_time must be a positive number"]),
+        ("sewing_time = 1.0", "sewing_tiem = 1.0", &["garment.sewing_tiem", "unknown field"]),
+        // The form.
+        ("size = \"uk-12\"", "size = \"uk-99\"", &["no size 'uk-99'", "uk-10, uk-12, uk-14"]),
+        ("size = \"uk-12\"", "obj = \"no/such/body.obj\"", &["garment.form.obj", "no such file"]),
+        ("size = \"uk-12\"", "size = \"uk-12\"\nobj = \"assets/cushion.obj\"", &["garment.form", "exactly one of size, measurements or obj"]),
+    ];
+    for (from, to, words) in cases {
+        let bad = gored.replacen(from, to, 1);
+        assert_ne!(bad, gored, "{from}");
+        let err = match load_text("malformed", &bad) {
+            Ok(config) => Scene::build(config).err().unwrap_or_else(|| panic!("built: {to}")).to_string(),
+            Err(err) => err,
+        };
+        assert!(words.iter().all(|w| err.contains(w)), "{to}: {err}");
+    }
+    // A mesh too fine for memory is refused before meshing, with the edge that fits.
+    let err = load_scene("skirt-gored-straight", &["mesh.edge_length=0.00005".into()]).expect_err("too fine").to_string();
+    assert!(err.contains("mesh.edge_length = 5e-5 m") && err.contains("use at least"), "{err}");
+}
+
 /// The gored skirt on a coarse mesh: every seam closes under the sewing springs to a
 /// quarter of the contact layer before the sewing time, is welded, and the welded seam's
 /// length stays that of both sides' rest lengths (the skirt hangs at small strain).
