@@ -67,16 +67,22 @@ fn bad_patterns_are_refused_naming_the_panel_and_the_edge() {
         ("units = \"cm\"", "units = \"cm\"\nsewing_ramp = 2", &["garment.sewing_ramp = 2 s is not shorter than garment.sewing_time"]),
     ];
     for (from, to, words) in cases {
-        let bad = gored.replacen(from, to, 1);
-        assert_ne!(bad, gored, "{from}");
-        let err = load_text("bad", &bad).expect_err(to);
+        let err = refusal(&gored, from, to);
         assert!(words.iter().all(|w| err.contains(w)), "{to}: {err}");
     }
 }
 
+/// The error reading `text` with its first `from` replaced by `to` (which must change it):
+/// refused as the file is read, before any scene is built.
+fn refusal(text: &str, from: &str, to: &str) -> String {
+    let bad = text.replacen(from, to, 1);
+    assert_ne!(bad, text, "{from}");
+    load_text("bad", &bad).expect_err(to)
+}
+
 /// What a pattern file can get wrong beyond the cases above, each refused before any step
-/// (when the file is read or the scene is built) with a message that names the key, the
-/// panel or the edge, and says what would fix it.
+/// (as the file is read, or a missing form mesh as the scene is built) with a message that
+/// names the key, the panel or the edge, and says what would fix it.
 #[test]
 fn malformed_outlines_seams_and_forms_are_refused_naming_their_key() {
     let gored = bundled("skirt-gored-straight");
@@ -84,7 +90,7 @@ fn malformed_outlines_seams_and_forms_are_refused_naming_their_key() {
     let clockwise = "edges = [\n  { name = \"left\", to = [-8.8, 55] },\n  { name = \"waist\", to = [8.8, 55], through = [0, 54.1131] },\n  { name = \"right\", to = [20, 0] },\n  { name = \"hem\", to = [-20, 0], through = [0, -2.0157] },\n]";
     let hem = "{ name = \"hem\", to = [20, 0], through = [0, -2.0157] }";
     let last = "{ name = \"left\", to = [-20, 0] },\n]";
-    let cases: [(&str, &str, &[&str]); 21] = [
+    let cases: [(&str, &str, &[&str]); 20] = [
         // Outlines.
         (outline, clockwise, &["'front'", "runs clockwise", "counter-clockwise"]),
         (last, "{ name = \"left\", to = [-20, 1] },\n]", &["'front'", "'left' must end at start"]),
@@ -108,18 +114,16 @@ fn malformed_outlines_seams_and_forms_are_refused_naming_their_key() {
         ("sewing_time = 1.0", "sewing_tiem = 1.0", &["garment.sewing_tiem", "unknown field"]),
         // The form.
         ("size = \"uk-12\"", "size = \"uk-99\"", &["no size 'uk-99'", "uk-10, uk-12, uk-14"]),
-        ("size = \"uk-12\"", "obj = \"no/such/body.obj\"", &["garment.form.obj", "no such file"]),
         ("size = \"uk-12\"", "size = \"uk-12\"\nobj = \"assets/cushion.obj\"", &["garment.form", "exactly one of size, measurements or obj"]),
     ];
     for (from, to, words) in cases {
-        let bad = gored.replacen(from, to, 1);
-        assert_ne!(bad, gored, "{from}");
-        let err = match load_text("malformed", &bad) {
-            Ok(config) => Scene::build(config).err().unwrap_or_else(|| panic!("built: {to}")).to_string(),
-            Err(err) => err,
-        };
+        let err = refusal(&gored, from, to);
         assert!(words.iter().all(|w| err.contains(w)), "{to}: {err}");
     }
+    // A form mesh that is not there: refused when the scene is built, before any step.
+    let config = load_text("no-form", &gored.replacen("size = \"uk-12\"", "obj = \"no/such/body.obj\"", 1)).unwrap();
+    let err = Scene::build(config).err().expect("a missing form mesh is refused").to_string();
+    assert!(err.contains("garment.form.obj") && err.contains("no such file"), "{err}");
     // A mesh too fine for memory is refused before meshing, with the edge that fits.
     let err = load_scene("skirt-gored-straight", &["mesh.edge_length=0.00005".into()]).expect_err("too fine").to_string();
     assert!(err.contains("mesh.edge_length = 5e-5 m") && err.contains("use at least"), "{err}");
