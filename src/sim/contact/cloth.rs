@@ -21,6 +21,33 @@ pub struct NearPairs {
     vertex_triangle: Vec<(u32, u32)>,
     /// (edge, edge) indices, first < second, sharing no vertex.
     edge_edge: Vec<(u32, u32)>,
+    /// The pairs along the last step's paths, where that step searched them
+    /// (`NearPairs::swept`): the same step's crossing check takes them again.
+    along_paths: Option<Box<PathPairs>>,
+}
+
+/// Pairs whose paths from `start` to `end` (less their mean motion) come within `reach`,
+/// for one step.
+#[derive(Debug, Clone)]
+struct PathPairs {
+    start: Vec<DVec3>,
+    end: Vec<DVec3>,
+    reach: f64,
+    pairs: NearPairs,
+}
+
+impl PathPairs {
+    /// Whether every pair whose paths from `start` to `end` come within `margin` is listed:
+    /// the same start, and ends that depart from the listed ones, less the mean departure,
+    /// by at most half of what the reach leaves over `margin`. Each vertex's box (around its
+    /// start and its end less the mean motion) then lies within that departure of its
+    /// listed box, and a box around several vertices within the largest of theirs.
+    fn covers(&self, cloth: Cloth, start: &[DVec3], end: &[DVec3], margin: f64, relative: bool) -> bool {
+        if self.start.len() != start.len() || self.pairs.topology != (cloth.triangles.len(), cloth.edges.len()) || self.pairs.bands != bands_checksum(cloth) || self.start != start {
+            return false;
+        }
+        margin + 2.0 * largest_move(&self.end, end, relative) <= self.reach
+    }
 }
 
 impl NearPairs {
@@ -110,7 +137,7 @@ impl NearPairs {
             });
             found[first..].sort_unstable();
         });
-        Self { origin: Vec::new(), topology: (triangles.len(), edges.len()), bands: bands_checksum(cloth), reach, vertex_triangle, edge_edge }
+        Self { origin: Vec::new(), topology: (triangles.len(), edges.len()), bands: bands_checksum(cloth), reach, vertex_triangle, edge_edge, along_paths: None }
     }
 }
 
@@ -121,11 +148,17 @@ fn bands_checksum(cloth: Cloth) -> u64 {
 
 /// From this relative motion in a step, in mean edges (twice the largest centred move),
 /// the fast path searches along the vertices' paths instead of renewing the list around
-/// the start. The list's size grows as the square of its reach and the paths' as their
-/// length: on the sphere drop's first 0.4 s (one thread) searching along paths from 1, 2, 4
-/// and never took 1.16, 1.13, 1.71 and 2.52 s of contact; on the 20k-triangle drape, whose
-/// sloping skirt's paths have wide boxes, 4.43, 3.12, 2.99 and 3.04 s.
-const SWEPT_FROM_EDGES: f64 = 2.0;
+/// the start: a list renewed there, its reach widened by that motion, would be renewed
+/// again within two steps of the same motion (its skin is half an edge), where the search
+/// along one step's paths lists far fewer pairs (in a 10k circle skirt's fall, 1.4 million
+/// around the start at 40 mm reach against 0.2–0.4 million along the paths). Searching along paths
+/// from 2, 1, 0.5 and 0.25 edges, with the same counts to the iteration (the list only
+/// narrows what the step's filter examines), contact took 2.92, 2.05, 1.90 and 1.81 s on
+/// the 20k drape; 2.24, 1.81, 1.79 and 1.65 s on the tablecloth; on the sphere drop's first
+/// 0.4 s (one thread) 1.98, 1.72, 1.66 and 1.62 s; on the 10k circle skirt's first 2 s 7.04
+/// s at 2 and 5.27 s at 0.25 (docs/performance-log.md, "2026-12-06, thirteenth sitting").
+/// At rest the list, which lasts many steps, is renewed instead.
+const SWEPT_FROM_EDGES: f64 = 0.25;
 
 /// The near-pair list's skin: half an edge lets a draping cloth keep its list for many
 /// steps while adding few pairs beyond those in reach.
@@ -173,12 +206,21 @@ impl ContactModel {
     /// falling a tenth of a metre a step), would need a list as wide as that around every
     /// vertex: millions of pairs, sifted every step. It takes the pairs whose paths' boxes
     /// come within `margin + allowance` instead, made for this step alone.
+    ///
+    /// Pairs searched along paths are kept with the list for the rest of the step: the
+    /// crossing check after the solve takes them again wherever the solved paths stay close
+    /// enough to the predicted ones (`PathPairs::covers`) instead of searching its own.
     fn candidates<'n>(&self, cloth: Cloth, near: &'n mut NearPairs, start: &[DVec3], end: &[DVec3], margin: f64, allowance: f64) -> Cow<'n, NearPairs> {
         let relative = self.settings.relative_motion;
+        if near.along_paths.as_deref().is_some_and(|kept| kept.covers(cloth, start, end, margin, relative)) {
+            return Cow::Borrowed(&near.along_paths.as_deref().expect("checked above").pairs);
+        }
         let motion = largest_move(start, end, relative);
         if relative && 2.0 * motion > SWEPT_FROM_EDGES * cloth.mean_edge_length && !near.covers(cloth, start, motion, margin, relative) {
             let centre = common_motion(start, end, relative);
-            return Cow::Owned(NearPairs::swept(start, end, centre, cloth, margin + allowance));
+            let pairs = NearPairs::swept(start, end, centre, cloth, margin + allowance);
+            let kept = near.along_paths.insert(Box::new(PathPairs { start: start.to_vec(), end: end.to_vec(), reach: margin + allowance, pairs }));
+            return Cow::Borrowed(&kept.pairs);
         }
         Cow::Borrowed(self.near_pairs(cloth, near, start, motion, margin))
     }
@@ -523,6 +565,36 @@ mod tests {
         let at = |p: DVec2, t: f64| if p.x <= 0.02 { DVec3::new(p.x, p.y, 0.0) } else { DVec3::new(0.04 - p.x, p.y, 0.035 - 0.01 * t) };
         let total = pairs_over_steps(&model, &contact, 5, true, at);
         assert!(total > 100, "the falling layer should come within reach of the lower one: {total}");
+    }
+
+    /// The crossing check after a step's solve takes the pairs the step searched along its
+    /// predicted paths, where the solved ends depart from the predicted ones by less than
+    /// half the allowance: it must stop exactly the crossings a search of its own stops.
+    /// An upper layer 3 mm above a lower one is predicted 6 mm down through it (three
+    /// edges, so the pairs are searched along the paths), and solved to ends that depart
+    /// from that by up to 0.4 mm; then by 4 mm, past what the kept pairs cover.
+    #[test]
+    fn the_crossing_check_takes_the_steps_pairs_along_paths_and_stops_the_same_crossings() {
+        let (model, contact) = strip(0.002, true);
+        let cloth = model.cloth();
+        let upper = |p: DVec2| p.x > 0.02;
+        let start: Vec<DVec3> = model.rest.iter().map(|&p| if upper(p) { DVec3::new(0.04 - p.x, p.y, 0.003) } else { DVec3::new(p.x, p.y, 0.0) }).collect();
+        let predicted: Vec<DVec3> = start.iter().zip(&model.rest).map(|(&x, &p)| if upper(p) { x - DVec3::Z * 0.006 } else { x }).collect();
+        for (departure, kept) in [(0.0004, true), (0.004, false)] {
+            let end: Vec<DVec3> = predicted.iter().enumerate().map(|(i, &x)| x + DVec3::new((i as f64).sin(), (1.7 * i as f64).cos(), 0.5) * (departure / 1.5)).collect();
+            let mut near = NearPairs::default();
+            contact.begin_step(cloth, &mut near, &start, &[], &predicted, 0.004);
+            let listed = near.along_paths.as_ref().map(|k| k.pairs.vertex_triangle.len() + k.pairs.edge_edge.len()).expect("the step searched along its paths");
+            let eps = 1e-3 * contact.settings.self_thickness_for(cloth.mean_edge_length);
+            let taken = contact.candidates(cloth, &mut near, &start, &end, eps, 0.0).into_owned();
+            assert_eq!(taken.vertex_triangle.len() + taken.edge_edge.len() == listed, kept, "departure {departure}: {listed} pairs kept");
+            let (mut end_kept, mut v_kept) = (end.clone(), vec![DVec3::X; end.len()]);
+            let (mut end_own, mut v_own) = (end.clone(), vec![DVec3::X; end.len()]);
+            let stopped = contact.stop_self_crossings(cloth, &mut near, &start, &mut end_kept, &mut v_kept);
+            let own = contact.stop_self_crossings(cloth, &mut NearPairs::default(), &start, &mut end_own, &mut v_own);
+            assert!(stopped > 10, "the upper layer crosses the lower one: {stopped} crossings stopped");
+            assert_eq!((stopped, &end_kept, &v_kept), (own, &end_own, &v_own), "departure {departure}");
+        }
     }
 
     /// A sheet hanging still, as a drape's skirt nearly does, whose predicted path is a
