@@ -255,6 +255,7 @@ fn a_negative_or_nan_perturbation_no_longer_panics() {
 fn zero_newton_or_cg_iterations_are_refused_instead_of_reported_stable() {
     assert_refused(&["run", "cantilever", "--set", "solver.newton.max_iterations=0"], &["solver.newton.max_iterations"]);
     assert_refused(&["run", "cantilever", "--set", "solver.newton.cg_max_iterations=0"], &["solver.newton.cg_max_iterations"]);
+    assert_refused(&["run", "skirt-gored-bias", "--fast", "--set", "solver.fast.cg_max_iterations=0"], &["solver.fast.cg_max_iterations", "at least 1"]);
 }
 
 /// Recycled directions cost memory and a product each per solve: a count no solve could

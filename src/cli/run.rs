@@ -312,6 +312,10 @@ fn unconverged_advice(config: &SceneConfig) -> String {
             n.cg_max_iterations, defaults.cg_max_iterations
         ));
     }
+    let fast = &config.solver.fast;
+    if config.solver.path == rosette::settings::SolverPath::Fast && config.scene.kind == rosette::settings::SceneKind::Garment && fast.cg_max_iterations < n.cg_max_iterations {
+        advice.push(format!("raise solver.fast.cg_max_iterations (now {}): a garment's linear solves stop there on the fast path", fast.cg_max_iterations));
+    }
     if n.cg_tolerance > defaults.cg_tolerance {
         advice.push(format!("lower solver.newton.cg_tolerance (now {}, default {})", short(n.cg_tolerance), short(defaults.cg_tolerance)));
     }

@@ -117,7 +117,7 @@ impl RunPlan {
             let _ = writeln!(text, "  step: {}, dt {} s{step}, damping {} 1/s{}", s.integrator.name(), s.dt, s.damping, if s.adaptive.is_some() { ", adaptive" } else { "" });
             let _ = writeln!(
                 text,
-                "  {}: at most {} iterations, tolerance {} of the mean edge{}, preconditioner {}{}, indefinite {}, retry exact {}{}",
+                "  {}: at most {} iterations, tolerance {} of the mean edge{}, preconditioner {}{}, indefinite {}, retry exact {}{}{}",
                 n.minimizer.name(),
                 n.max_iterations,
                 n.tolerance,
@@ -131,6 +131,7 @@ impl RunPlan {
                 key_name(&n.indefinite),
                 n.retry_exact,
                 if n.recycled_directions > 0 { format!(", CG deflated by the last {} directions", n.recycled_directions) } else { String::new() },
+                if n.cg_max_iterations < crate::sim::NewtonSettings::default().cg_max_iterations { format!(", CG stopped at {} iterations a solve", n.cg_max_iterations) } else { String::new() },
             );
             if !c.props.is_empty() || c.contact.self_collision {
                 let factor = c.contact.stiffness / scene.contact.stiffness;
@@ -241,8 +242,11 @@ pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
     level.solver.newton.error_share = if kind == Design::Motion { fast.motion_error_share } else { fast.error_share };
     // A garment coming to rest repeats its slow swing from step to step: its solves are
     // deflated by the last Newton directions (docs/fast-path.md, item 7).
+    // A few of its solves run to thousands of CG iterations on a fresh factor: they stop
+    // at the fast path's limit, and Newton goes on from a fresh factor.
     if kind == Design::Garment {
         level.solver.newton.recycled_directions = fast.recycled_directions;
+        level.solver.newton.cg_max_iterations = level.solver.newton.cg_max_iterations.min(fast.cg_max_iterations);
     }
     // A cloth landing on a prop buckles in most iterations of its landing steps: once
     // the exact matrix has failed in a step, the rest of the step is solved on the

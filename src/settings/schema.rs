@@ -351,11 +351,17 @@ pub struct FastSettings {
     /// resolved it in 100–190 CG iterations a solve near the end (docs/performance-log.md,
     /// "2026-12-05").
     pub recycled_directions: usize,
+    /// The most CG iterations a garment's linear solve takes (`solver.newton.cg_max_iterations`,
+    /// where that is lower it holds): a solve stopped there hands Newton the direction it has,
+    /// its next iteration takes a fresh factor, and Newton cannot stop on it. A few solves of
+    /// a 10k garment's fall ran to 500–2 000 iterations on a fresh factor, each as costly as
+    /// tens of Newton iterations (docs/performance-log.md, "2026-12-06, thirteenth sitting").
+    pub cg_max_iterations: usize,
 }
 
 impl Default for FastSettings {
     fn default() -> Self {
-        Self { dt: 0.064, drop_dt: 0.016, garment_dt: 0.024, coarsest_edge_share: 0.5, error_share: 0.1, motion_error_share: 0.3, recycled_directions: 8 }
+        Self { dt: 0.064, drop_dt: 0.016, garment_dt: 0.024, coarsest_edge_share: 0.5, error_share: 0.1, motion_error_share: 0.3, recycled_directions: 8, cg_max_iterations: 400 }
     }
 }
 

@@ -194,8 +194,10 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
     if n.max_iterations == 0 {
         return Err(invalid("solver.newton.max_iterations", format!("solver.newton.max_iterations must be at least 1 (default {}): with none, no step is solved", crate::sim::solver::DEFAULT_MAX_ITERATIONS)));
     }
-    if n.cg_max_iterations == 0 {
-        return Err(invalid("solver.newton.cg_max_iterations", "solver.newton.cg_max_iterations must be at least 1 (default 3000): with none, Newton has no direction".into()));
+    for (key, count, default) in [("solver.newton.cg_max_iterations", n.cg_max_iterations, 3000), ("solver.fast.cg_max_iterations", solver.fast.cg_max_iterations, 400)] {
+        if count == 0 {
+            return Err(invalid(key, format!("{key} must be at least 1 (default {default}): with none, Newton has no direction")));
+        }
     }
     positive_at_most("solver.newton.tolerance", n.tolerance, 0.1, "a tenth of an edge: Newton would stop before it starts; the default is 1e-5")?;
     positive("solver.newton.cg_tolerance", n.cg_tolerance)?;

@@ -15,6 +15,16 @@ pub struct CgReport {
     /// The matrix showed a direction of non-positive curvature (it is not positive
     /// definite); the solve stopped there.
     pub negative_curvature: bool,
+    /// The residual came under the tolerance (false where the solve stopped at its
+    /// iteration limit or at negative curvature).
+    pub reached: bool,
+}
+
+impl CgReport {
+    /// The solve stopped at its iteration limit with the residual above its tolerance.
+    pub fn stopped_short(&self) -> bool {
+        !self.reached && !self.negative_curvature
+    }
 }
 
 fn dot(a: &[DVec3], b: &[DVec3]) -> f64 {
@@ -87,7 +97,7 @@ pub fn pcg_deflated(
     let mut r: Vec<DVec3> = b.iter().zip(a.fixed).map(|(&v, &f)| if f { DVec3::ZERO } else { v }).collect();
     let b_norm = dot(&r, &r).sqrt();
     if b_norm == 0.0 {
-        return CgReport { iterations: 0, relative_residual: 0.0, negative_curvature: false };
+        return CgReport { iterations: 0, relative_residual: 0.0, negative_curvature: false, reached: true };
     }
     let deflation = recycled.and_then(|recycled| Deflation::new(a, recycled));
     let mut residual = 1.0;
@@ -97,7 +107,7 @@ pub fn pcg_deflated(
         d.add(&d.aw, &c, &mut r, -1.0);
         residual = dot(&r, &r).sqrt() / b_norm;
         if residual <= tolerance {
-            return CgReport { iterations: 0, relative_residual: residual, negative_curvature: false };
+            return CgReport { iterations: 0, relative_residual: residual, negative_curvature: false, reached: true };
         }
     }
     let mut z = vec![DVec3::ZERO; n];
@@ -136,7 +146,7 @@ pub fn pcg_deflated(
         preconditioner.apply(&r, &mut z);
         rz = next_direction(&r, &z, &mut p, Some(rz), deflation.as_ref());
     }
-    CgReport { iterations, relative_residual: residual, negative_curvature }
+    CgReport { iterations, relative_residual: residual, negative_curvature, reached: residual <= tolerance }
 }
 
 /// The next search direction p = z + β p − W (WᵀAW)⁻¹ (AW)ᵀ z = z + β p − V (AV)ᵀ z, with

@@ -131,6 +131,9 @@ struct NewtonHistory {
     /// This iteration's direction was solved on the bounded matrix, which is not Φ's
     /// Hessian along the buckling modes: Newton converges linearly there.
     bounded_direction: bool,
+    /// This iteration's solve stopped at CG's iteration limit: its direction is shorter
+    /// than Newton's step (CG's iterates grow in length), so it cannot show convergence.
+    truncated: bool,
 }
 
 /// How an iteration's line search ended.
@@ -175,7 +178,9 @@ impl Integrator {
             let bending = model.bending_newton_matrix(y);
             let cg_tolerance = self.forcing_tolerance(&history, norm, problem.tolerance);
             history.previous_norm = Some(norm);
+            let truncated_before = report.truncated_solves;
             history.bounded_direction = self.solve_direction(&problem, &mut work, y, bending.as_deref(), cg_tolerance, &mut history.bounded_throughout, report, &mut watch);
+            history.truncated = report.truncated_solves > truncated_before;
             if problem.all_free {
                 keep_momentum(&problem.mass_diagonal, &work.gradient, &mut work.direction);
             }
@@ -402,7 +407,7 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
         _ => 0.0,
     };
     history.previous_step = Some(step_size);
-    history.previous_full_step = Some(length).filter(|_| accepted && alpha == 1.0);
+    history.previous_full_step = Some(length).filter(|_| accepted && alpha == 1.0 && !history.truncated);
     history.previous_direction = Some(length);
     // Newton has converged when its whole step is under the tolerance, not the part of it
     // the line search or a cloth–cloth pair's step limit let it take: a step cut to a
@@ -417,7 +422,7 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
         }
     }
     std::mem::swap(y, trial);
-    if length.max(step_size).max(remaining) < problem.tolerance { Progress::Converged } else { Progress::Continue }
+    if !history.truncated && length.max(step_size).max(remaining) < problem.tolerance { Progress::Converged } else { Progress::Continue }
 }
 
 /// With nothing fixed and nothing touched, corrects a Newton direction d so that momentum

@@ -36,6 +36,8 @@ pub struct StepReport {
     pub cg_iterations: usize,
     /// Preconditioners built (factorisations, complete or incomplete; failed ones included).
     pub factorizations: usize,
+    /// Linear solves stopped at `NewtonSettings::cg_max_iterations` above their tolerance.
+    pub truncated_solves: usize,
     /// True when Newton stopped at its iteration limit before reaching its tolerance.
     pub newton_unconverged: bool,
     /// Newton's last step (the largest vertex move) over the mean edge length: below
@@ -73,6 +75,7 @@ impl StepReport {
         self.quasi_newton_iterations += other.quasi_newton_iterations;
         self.cg_iterations += other.cg_iterations;
         self.factorizations += other.factorizations;
+        self.truncated_solves += other.truncated_solves;
         self.timings += other.timings;
         self.shift = self.shift.max(other.shift);
     }
