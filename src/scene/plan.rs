@@ -241,9 +241,9 @@ pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
     // (docs/performance-log.md).
     level.solver.newton.error_share = if kind == Design::Motion { fast.motion_error_share } else { fast.error_share };
     // A garment coming to rest repeats its slow swing from step to step: its solves are
-    // deflated by the last Newton directions (docs/fast-path.md, item 7).
-    // A few of its solves run to thousands of CG iterations on a fresh factor: they stop
-    // at the fast path's limit, and Newton goes on from a fresh factor.
+    // deflated by the last Newton directions (docs/fast-path.md, item 7). A few of its
+    // solves run to thousands of CG iterations even on a fresh factor: they stop at the
+    // fast path's limit, and Newton goes on with a fresh factor (item 8).
     if kind == Design::Garment {
         level.solver.newton.recycled_directions = fast.recycled_directions;
         level.solver.newton.cg_max_iterations = level.solver.newton.cg_max_iterations.min(fast.cg_max_iterations);

@@ -81,8 +81,7 @@ impl Integrator {
             }
             let cached = self.preconditioner.as_mut().expect("built above");
             let cg = pcg(&system, &cached.preconditioner, solve.rhs, direction, solve.cg_tolerance, self.newton.cg_max_iterations);
-            solve.report.cg_iterations += cg.iterations;
-            solve.report.truncated_solves += usize::from(cg.stopped_short());
+            solve.report.count_solve(&cg);
             solve.watch.solve();
             let descent = solve.rhs.iter().zip(direction.iter()).map(|(r, d)| r.dot(*d)).sum::<f64>() > 0.0;
             if cg.negative_curvature || !descent {
@@ -141,8 +140,7 @@ impl Integrator {
             }
             let cached = self.preconditioner.as_mut().expect("built above");
             let cg = pcg(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations);
-            report.cg_iterations += cg.iterations;
-            report.truncated_solves += usize::from(cg.stopped_short());
+            report.count_solve(&cg);
             watch.solve();
             cached.record(&cg);
         }
@@ -213,8 +211,7 @@ impl Integrator {
         let deflation = (keep > 0).then_some(&*recycled);
         let exact = exact_first.then(|| {
             let cg = pcg_deflated(system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations, deflation);
-            report.cg_iterations += cg.iterations;
-            report.truncated_solves += usize::from(cg.stopped_short());
+            report.count_solve(&cg);
             watch.solve();
             cg
         });
@@ -231,8 +228,7 @@ impl Integrator {
                 }
                 let system = SystemMatrix { stiffness: bounded, ..*system };
                 let cg = pcg_deflated(&system, &cached.preconditioner, rhs, direction, cg_tolerance, self.newton.cg_max_iterations, deflation);
-                report.cg_iterations += cg.iterations;
-                report.truncated_solves += usize::from(cg.stopped_short());
+                report.count_solve(&cg);
                 watch.solve();
                 cached.record(&cg);
                 recycled.remember(direction, keep);

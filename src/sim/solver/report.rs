@@ -1,6 +1,7 @@
 //! What a step reports: its cost, and why it was rejected.
 
 use super::IntegratorKind;
+use crate::sim::linalg::CgReport;
 use serde::Serialize;
 use std::time::Instant;
 use thiserror::Error;
@@ -67,6 +68,12 @@ impl StepReport {
     /// tolerance; always for the explicit integrator).
     pub fn converged(&self) -> bool {
         self.newton_residual <= UNCONVERGED_FACTOR * self.newton_tolerance
+    }
+
+    /// Counts a linear solve: its CG iterations, and whether it stopped at the limit.
+    pub(super) fn count_solve(&mut self, cg: &CgReport) {
+        self.cg_iterations += cg.iterations;
+        self.truncated_solves += usize::from(cg.stopped_short());
     }
 
     /// Adds another attempt's work (iterations and time).
