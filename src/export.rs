@@ -16,7 +16,9 @@
 //! driven by an action, three.js as morph targets played by its AnimationMixer.
 
 use crate::render::{Frame, RenderOptions};
-use glam::{DVec2, DVec3};
+use crate::scene::Topology;
+use std::sync::Arc;
+use glam::DVec3;
 use serde_json::{Value, json};
 use std::path::Path;
 use thiserror::Error;
@@ -38,21 +40,14 @@ pub enum ExportError {
     Write { path: String, message: String },
 }
 
-/// The cloth's topology and rest shape, which every frame shares.
-#[derive(Debug, Clone, Copy)]
-pub struct Cloth<'a> {
-    /// Triangles, counter-clockwise in the rest plane (the front face's winding).
-    pub triangles: &'a [[u32; 3]],
-    /// Rest positions in the sample plane, m.
-    pub rest: &'a [DVec2],
-    /// Angle of the warp from the rest x axis, radians (`sim::Model::warp_angle`).
-    pub warp_angle: f64,
-    /// The mesh's name in the file.
-    pub name: &'a str,
+/// One moment of the cloth: simulated time (s), the mesh then and its vertex positions
+/// (m, z up), one per vertex of the mesh.
+#[derive(Debug, Clone)]
+pub struct ClothFrame {
+    pub time: f64,
+    pub topology: Arc<Topology>,
+    pub positions: Vec<DVec3>,
 }
-
-/// One moment of the cloth: simulated time (s) and vertex positions (m, z up).
-pub type ClothFrame = (f64, Vec<DVec3>);
 
 /// A scene's position in glTF's frame: y up, right-handed.
 fn to_gltf(p: DVec3) -> [f32; 3] {
@@ -123,75 +118,87 @@ impl Builder {
     }
 }
 
-/// The file's bytes: `frames` of `cloth` (one frame: a still; more: an animation).
-pub fn glb(cloth: &Cloth, frames: &[ClothFrame]) -> Result<Vec<u8>, ExportError> {
-    let Some((_, first)) = frames.first() else { return Err(ExportError::Empty("no frame".into())) };
-    if first.is_empty() || cloth.triangles.is_empty() {
-        return Err(ExportError::Empty("the cloth has no triangles".into()));
+/// The file's bytes: `frames` of the cloth named `name` (one frame: a still; more: an
+/// animation). Frames on one mesh share one glTF mesh whose later frames are morph
+/// targets; where the mesh changes during the run (a garment's weld, a finer level of the
+/// fast path) each mesh is a node of its own, shown by its scale (1, or 0 to hide it) from
+/// its first frame until the next mesh's, with a step interpolation.
+pub fn glb(name: &str, frames: &[ClothFrame]) -> Result<Vec<u8>, ExportError> {
+    if frames.is_empty() {
+        return Err(ExportError::Empty("no frame".into()));
     }
-    if let Some((t, x)) = frames.iter().find(|(_, x)| x.len() != first.len() || x.iter().any(|p| !p.is_finite())) {
-        return Err(ExportError::Empty(format!("the frame at t = {t} s has {} vertices or a position that is not finite", x.len())));
-    }
-    let mut b = Builder::default();
-    let indices: Vec<u8> = cloth.triangles.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
-    let index_view = b.view(&indices, Some(ELEMENT_ARRAY_BUFFER));
-    b.accessors.push(json!({ "bufferView": index_view, "componentType": UNSIGNED_INT, "count": 3 * cloth.triangles.len(), "type": "SCALAR" }));
-    let positions: Vec<[f32; 3]> = first.iter().map(|&p| to_gltf(p)).collect();
-    let normals = vertex_normals(first, cloth.triangles);
-    let period = f64::from(RenderOptions::default().weave_period);
-    let uv: Vec<[f32; 2]> = Frame::from_cloth(first, cloth.triangles, cloth.rest, cloth.warp_angle)
-        .cloth_uv
-        .iter()
-        .map(|[u, v]| [(f64::from(*u) / period) as f32, (f64::from(*v) / period) as f32])
-        .collect();
-    let position = b.floats(&positions, "VEC3", Some(ARRAY_BUFFER));
-    let normal = b.floats(&normals, "VEC3", Some(ARRAY_BUFFER));
-    let texcoord = b.floats(&uv, "VEC2", Some(ARRAY_BUFFER));
-    let mut primitive = json!({
-        "attributes": { "POSITION": position, "NORMAL": normal, "TEXCOORD_0": texcoord },
-        "indices": 0, "material": 0, "mode": 4,
-    });
-    let mut mesh = json!({ "name": cloth.name, "primitives": [] });
-    let mut animations = Vec::new();
-    if frames.len() > 1 {
-        let mut targets = Vec::new();
-        let mut names = Vec::new();
-        for (t, x) in &frames[1..] {
-            let delta: Vec<[f32; 3]> = x.iter().zip(&positions).map(|(&p, q)| {
-                let p = to_gltf(p);
-                [p[0] - q[0], p[1] - q[1], p[2] - q[2]]
-            })
-            .collect();
-            let n = vertex_normals(x, cloth.triangles);
-            let n_delta: Vec<[f32; 3]> = n.iter().zip(&normals).map(|(a, b)| [a[0] - b[0], a[1] - b[1], a[2] - b[2]]).collect();
-            targets.push(json!({ "POSITION": b.floats(&delta, "VEC3", Some(ARRAY_BUFFER)), "NORMAL": b.floats(&n_delta, "VEC3", Some(ARRAY_BUFFER)) }));
-            names.push(format!("t = {t:.3} s"));
+    for f in frames {
+        if f.topology.triangles.is_empty() || f.positions.is_empty() {
+            return Err(ExportError::Empty("the cloth has no triangles".into()));
         }
-        let count = targets.len();
-        primitive["targets"] = json!(targets);
-        mesh["weights"] = json!(vec![0.0; count]);
-        // Blender names the shape keys from here.
-        mesh["extras"] = json!({ "targetNames": names });
-        let start = frames[0].0;
-        let times: Vec<[f32; 1]> = frames.iter().map(|(t, _)| [(t - start) as f32]).collect();
-        let weights: Vec<[f32; 1]> = (0..frames.len()).flat_map(|k| (0..count).map(move |j| [if k == j + 1 { 1.0 } else { 0.0 }])).collect();
-        let input = b.floats(&times, "SCALAR", None);
-        let output = b.floats(&weights, "SCALAR", None);
-        animations.push(json!({
-            "name": "drape",
-            "samplers": [{ "input": input, "output": output, "interpolation": "LINEAR" }],
-            "channels": [{ "sampler": 0, "target": { "node": 0, "path": "weights" } }],
-        }));
+        if !f.topology.fits(&f.positions) || f.positions.iter().any(|p| !p.is_finite()) {
+            return Err(ExportError::Empty(format!(
+                "the frame at t = {} s has {} positions for a mesh of {} vertices, or a position that is not finite",
+                f.time,
+                f.positions.len(),
+                f.topology.vertex_count
+            )));
+        }
     }
-    mesh["primitives"] = json!([primitive]);
+    if frames.windows(2).any(|w| !(w[1].time > w[0].time)) {
+        return Err(ExportError::Empty("the frames' times do not increase".into()));
+    }
+    // Runs of frames on one mesh.
+    let mut segments: Vec<&[ClothFrame]> = Vec::new();
+    let mut first = 0;
+    for k in 1..=frames.len() {
+        if k == frames.len() || frames[k].topology.version != frames[first].topology.version {
+            segments.push(&frames[first..k]);
+            first = k;
+        }
+    }
+    let start = frames[0].time;
+    let mut b = Builder::default();
+    let (mut meshes, mut nodes, mut samplers, mut channels) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (i, segment) in segments.iter().enumerate() {
+        let label = if segments.len() == 1 {
+            name.to_string()
+        } else {
+            format!("{name}, from t = {:.3} s ({} vertices)", segment[0].time, segment[0].topology.vertex_count)
+        };
+        let (mesh, weights) = segment_mesh(&mut b, segment, &label, start);
+        meshes.push(mesh);
+        let mut node = json!({ "mesh": i, "name": label });
+        if let Some((input, output)) = weights {
+            samplers.push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
+            channels.push(json!({ "sampler": samplers.len() - 1, "target": { "node": i, "path": "weights" } }));
+        }
+        if segments.len() > 1 {
+            // Shown from its first frame until the next mesh's first frame.
+            let from = (segment[0].time - start) as f32;
+            let until = segments.get(i + 1).map(|next| (next[0].time - start) as f32);
+            let mut keys: Vec<([f32; 1], [f32; 3])> = Vec::new();
+            if i > 0 {
+                keys.push(([0.0], [0.0; 3]));
+            }
+            keys.push(([from], [1.0; 3]));
+            if let Some(until) = until {
+                keys.push(([until], [0.0; 3]));
+            }
+            let times: Vec<[f32; 1]> = keys.iter().map(|k| k.0).collect();
+            let scales: Vec<[f32; 3]> = keys.iter().map(|k| k.1).collect();
+            let input = b.floats(&times, "SCALAR", None);
+            let output = b.floats(&scales, "VEC3", None);
+            samplers.push(json!({ "input": input, "output": output, "interpolation": "STEP" }));
+            channels.push(json!({ "sampler": samplers.len() - 1, "target": { "node": i, "path": "scale" } }));
+            // As the animation's first moment shows it, for readers that do not play it.
+            node["scale"] = json!(if i == 0 { [1.0; 3] } else { [0.0; 3] });
+        }
+        nodes.push(node);
+    }
     let image_view = b.view(WEAVE_PNG, None);
     let [r, g, bl] = RenderOptions::default().front_color.map(srgb_to_linear);
     let mut document = json!({
         "asset": { "version": "2.0", "generator": format!("rosette {}", env!("CARGO_PKG_VERSION")) },
         "scene": 0,
-        "scenes": [{ "nodes": [0] }],
-        "nodes": [{ "mesh": 0, "name": cloth.name }],
-        "meshes": [mesh],
+        "scenes": [{ "nodes": (0..nodes.len()).collect::<Vec<_>>() }],
+        "nodes": nodes,
+        "meshes": meshes,
         "materials": [{
             "name": "woven cloth",
             "doubleSided": true,
@@ -205,8 +212,8 @@ pub fn glb(cloth: &Cloth, frames: &[ClothFrame]) -> Result<Vec<u8>, ExportError>
         "bufferViews": b.views,
         "buffers": [{ "byteLength": 0 }],
     });
-    if !animations.is_empty() {
-        document["animations"] = json!(animations);
+    if !channels.is_empty() {
+        document["animations"] = json!([{ "name": "drape", "samplers": samplers, "channels": channels }]);
     }
     while !b.bin.len().is_multiple_of(4) {
         b.bin.push(0);
@@ -231,9 +238,68 @@ pub fn glb(cloth: &Cloth, frames: &[ClothFrame]) -> Result<Vec<u8>, ExportError>
     Ok(out)
 }
 
+/// One mesh's glTF mesh: the first of `frames` as its vertices, every later one a morph
+/// target (positions and normals less the first's). Returns the mesh and, with more than
+/// one frame, the accessors of its weights' animation: times (s from `start`) and weights,
+/// frame k showing target k − 1 alone.
+fn segment_mesh(b: &mut Builder, frames: &[ClothFrame], label: &str, start: f64) -> (Value, Option<(usize, usize)>) {
+    let topology = &frames[0].topology;
+    let first = &frames[0].positions;
+    let indices: Vec<u8> = topology.triangles.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+    let index_view = b.view(&indices, Some(ELEMENT_ARRAY_BUFFER));
+    b.accessors.push(json!({ "bufferView": index_view, "componentType": UNSIGNED_INT, "count": 3 * topology.triangles.len(), "type": "SCALAR" }));
+    let index_accessor = b.accessors.len() - 1;
+    let positions: Vec<[f32; 3]> = first.iter().map(|&p| to_gltf(p)).collect();
+    let normals = vertex_normals(first, &topology.triangles);
+    let period = f64::from(RenderOptions::default().weave_period);
+    let uv: Vec<[f32; 2]> = Frame::from_cloth(first, &topology.triangles, &topology.texture, topology.warp_angle)
+        .cloth_uv
+        .iter()
+        .map(|[u, v]| [(f64::from(*u) / period) as f32, (f64::from(*v) / period) as f32])
+        .collect();
+    let position = b.floats(&positions, "VEC3", Some(ARRAY_BUFFER));
+    let normal = b.floats(&normals, "VEC3", Some(ARRAY_BUFFER));
+    let texcoord = b.floats(&uv, "VEC2", Some(ARRAY_BUFFER));
+    let mut primitive = json!({
+        "attributes": { "POSITION": position, "NORMAL": normal, "TEXCOORD_0": texcoord },
+        "indices": index_accessor, "material": 0, "mode": 4,
+    });
+    let mut mesh = json!({ "name": label, "primitives": [] });
+    let mut weights_animation = None;
+    if frames.len() > 1 {
+        let mut targets = Vec::new();
+        let mut names = Vec::new();
+        for frame in &frames[1..] {
+            let delta: Vec<[f32; 3]> = frame
+                .positions
+                .iter()
+                .zip(&positions)
+                .map(|(&p, q)| {
+                    let p = to_gltf(p);
+                    [p[0] - q[0], p[1] - q[1], p[2] - q[2]]
+                })
+                .collect();
+            let n = vertex_normals(&frame.positions, &topology.triangles);
+            let n_delta: Vec<[f32; 3]> = n.iter().zip(&normals).map(|(a, b)| [a[0] - b[0], a[1] - b[1], a[2] - b[2]]).collect();
+            targets.push(json!({ "POSITION": b.floats(&delta, "VEC3", Some(ARRAY_BUFFER)), "NORMAL": b.floats(&n_delta, "VEC3", Some(ARRAY_BUFFER)) }));
+            names.push(format!("t = {:.3} s", frame.time));
+        }
+        let count = targets.len();
+        primitive["targets"] = json!(targets);
+        mesh["weights"] = json!(vec![0.0; count]);
+        // Blender names the shape keys from here.
+        mesh["extras"] = json!({ "targetNames": names });
+        let times: Vec<[f32; 1]> = frames.iter().map(|f| [(f.time - start) as f32]).collect();
+        let weights: Vec<[f32; 1]> = (0..frames.len()).flat_map(|k| (0..count).map(move |j| [if k == j + 1 { 1.0 } else { 0.0 }])).collect();
+        weights_animation = Some((b.floats(&times, "SCALAR", None), b.floats(&weights, "SCALAR", None)));
+    }
+    mesh["primitives"] = json!([primitive]);
+    (mesh, weights_animation)
+}
+
 /// Writes [`glb`] to `path`.
-pub fn write_glb(path: &Path, cloth: &Cloth, frames: &[ClothFrame]) -> Result<(), ExportError> {
-    let bytes = glb(cloth, frames)?;
+pub fn write_glb(path: &Path, name: &str, frames: &[ClothFrame]) -> Result<(), ExportError> {
+    let bytes = glb(name, frames)?;
     crate::io::write::whole(path, &bytes).map_err(|e| ExportError::Write { path: path.display().to_string(), message: e.to_string() })
 }
 
@@ -259,31 +325,31 @@ impl Recorder {
         Self { frames, spacing: duration / (8 * (frames - 1)) as f64, next: start, samples: Vec::new() }
     }
 
-    /// Takes the state at `time` if a sample is due.
-    pub fn observe(&mut self, time: f64, x: &[DVec3]) {
+    /// Takes the cloth at `time` (its mesh and positions) if a sample is due.
+    pub fn observe(&mut self, time: f64, topology: &Arc<Topology>, x: &[DVec3]) {
         if time + 1e-9 >= self.next {
-            self.samples.push((time, x.to_vec()));
+            self.samples.push(ClothFrame { time, topology: Arc::clone(topology), positions: x.to_vec() });
             while self.next <= time + 1e-9 {
                 self.next += self.spacing.max(f64::MIN_POSITIVE);
             }
         }
     }
 
-    /// The frames: the state at `time` last, and those samples nearest in time to evenly
+    /// The frames: the cloth at `time` last, and those samples nearest in time to evenly
     /// spaced moments before it, each at most once (fewer frames than asked for only when
     /// the run was shorter than its sampling).
-    pub fn finish(mut self, time: f64, x: &[DVec3]) -> Vec<ClothFrame> {
-        if self.samples.last().is_none_or(|(t, _)| *t < time) {
-            self.samples.push((time, x.to_vec()));
+    pub fn finish(mut self, time: f64, topology: &Arc<Topology>, x: &[DVec3]) -> Vec<ClothFrame> {
+        if self.samples.last().is_none_or(|f| f.time < time) {
+            self.samples.push(ClothFrame { time, topology: Arc::clone(topology), positions: x.to_vec() });
         }
-        let start = self.samples[0].0;
+        let start = self.samples[0].time;
         let mut picked: Vec<usize> = (0..self.frames)
             .map(|k| {
                 let target = start + (time - start) * k as f64 / (self.frames - 1) as f64;
-                let i = self.samples.partition_point(|(t, _)| *t < target);
+                let i = self.samples.partition_point(|f| f.time < target);
                 // The nearer of the samples either side.
                 match (i.checked_sub(1), self.samples.get(i)) {
-                    (Some(j), Some((t, _))) if target - self.samples[j].0 < t - target => j,
+                    (Some(j), Some(f)) if target - self.samples[j].time < f.time - target => j,
                     (_, Some(_)) => i,
                     (Some(j), None) => j,
                     (None, None) => 0,
@@ -299,6 +365,7 @@ impl Recorder {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DVec2;
 
     #[test]
     fn normals_of_a_flat_sheet_point_up_in_gltf() {
@@ -307,16 +374,23 @@ mod tests {
         assert_eq!(vertex_normals(&x, &[[0, 1, 2]]), vec![[0.0, 1.0, 0.0]; 3]);
     }
 
+    /// A mesh of one triangle.
+    fn triangle() -> Arc<Topology> {
+        let texture = vec![DVec2::ZERO, DVec2::X, DVec2::Y];
+        Arc::new(Topology { version: 1, vertex_count: 3, triangles: vec![[0, 1, 2]], texture, warp_angle: 0.0, merged_from: None })
+    }
+
     #[test]
     fn the_recorder_spreads_its_frames_over_the_run_it_saw() {
         let mut r = Recorder::new(5, 0.0, 1.0);
-        let x = [DVec3::ZERO];
+        let topology = triangle();
+        let x = vec![DVec3::ZERO; topology.vertex_count];
         // A run that stops at 0.5 s of its 1 s, in 0.01 s steps.
         for k in 1..=50 {
-            r.observe(k as f64 * 0.01, &x);
+            r.observe(k as f64 * 0.01, &topology, &x);
         }
-        let frames = r.finish(0.5, &x);
-        let times: Vec<f64> = frames.iter().map(|f| f.0).collect();
+        let frames = r.finish(0.5, &topology, &x);
+        let times: Vec<f64> = frames.iter().map(|f| f.time).collect();
         assert_eq!(times.len(), 5);
         for (t, want) in times.iter().zip([0.01, 0.13, 0.26, 0.38, 0.5]) {
             assert!((t - want).abs() <= 0.0126, "{times:?}");

@@ -161,3 +161,96 @@ fn a_garment_exports_each_panel_in_its_warp_frame() {
     }
 }
 
+
+/// The positions of `primitive` at morph weights `weights`: its base plus each target's
+/// offsets scaled by its weight.
+fn morphed(primitive: &gltf::Primitive, blob: &[u8], weights: &[f32]) -> Vec<[f32; 3]> {
+    let reader = primitive.reader(|_| Some(blob));
+    let mut positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+    for (target, &w) in reader.read_morph_targets().zip(weights) {
+        for (p, d) in positions.iter_mut().zip(target.0.expect("positions in every target")) {
+            for k in 0..3 {
+                p[k] += w * d[k];
+            }
+        }
+    }
+    positions
+}
+
+/// A garment's seams weld during its run, and its vertex count drops: the animation holds
+/// one mesh before the weld and one after, each shown by its node's scale from its first
+/// frame to the next mesh's, and every frame reads back whole (the viewer once died at that
+/// weld, and this export failed with exit 4). The last frame is the still export's state.
+#[test]
+fn a_welded_garment_animates_across_its_weld() {
+    let (animated, still) = (temp("dress-animated.glb"), temp("dress-still.glb"));
+    let run = |path: &PathBuf, frames: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_rosette"))
+            .args(["run", "shift-dress", "--fast", "--set", "mesh.edge_length=0.035", "--export", path.to_str().unwrap()])
+            .args(frames)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    run(&animated, &["--export-frames", "12"]);
+    run(&still, &[]);
+    let bytes = std::fs::read(&animated).unwrap();
+    let gltf = gltf::Gltf::from_slice(&bytes).unwrap_or_else(|e| panic!("not valid glTF: {e:?}"));
+    let blob = gltf.blob.clone().unwrap();
+    let nodes: Vec<gltf::Node> = gltf.nodes().collect();
+    assert_eq!(nodes.len(), 2, "one mesh before the weld, one after");
+    let counts: Vec<usize> = nodes.iter().map(|n| n.mesh().unwrap().primitives().next().unwrap().get(&gltf::Semantic::Positions).unwrap().count()).collect();
+    assert!(counts[1] < counts[0], "the weld merges vertices: {counts:?}");
+    for node in &nodes {
+        let primitive = node.mesh().unwrap().primitives().next().unwrap();
+        let n = primitive.get(&gltf::Semantic::Positions).unwrap().count() as u32;
+        let indices: Vec<u32> = primitive.reader(|_| Some(&blob[..])).read_indices().unwrap().into_u32().collect();
+        assert!(indices.iter().all(|&i| i < n), "node {}: an index past its vertices", node.index());
+    }
+    // Each node's animated scale (step) and weights (linear), sampled at every key time.
+    let animation = gltf.animations().next().expect("an animation");
+    let mut scales: Vec<Vec<(f32, [f32; 3])>> = vec![Vec::new(); 2];
+    let mut weights: Vec<Vec<(f32, Vec<f32>)>> = vec![Vec::new(); 2];
+    for channel in animation.channels() {
+        let node = channel.target().node().index();
+        let reader = channel.reader(|_| Some(&blob[..]));
+        let times: Vec<f32> = reader.read_inputs().unwrap().collect();
+        match reader.read_outputs().unwrap() {
+            ReadOutputs::Scales(s) => {
+                assert_eq!(channel.sampler().interpolation(), gltf::animation::Interpolation::Step);
+                scales[node] = times.into_iter().zip(s).collect();
+            }
+            ReadOutputs::MorphTargetWeights(w) => {
+                let w: Vec<f32> = w.into_f32().collect();
+                let per = w.len() / times.len();
+                weights[node] = times.into_iter().enumerate().map(|(k, t)| (t, w[k * per..(k + 1) * per].to_vec())).collect();
+            }
+            other => panic!("an unexpected channel: {:?}", std::mem::discriminant(&other)),
+        }
+    }
+    let scale_at = |node: usize, t: f32| scales[node].iter().rev().find(|(k, _)| *k <= t).map_or(scales[node][0].1, |k| k.1);
+    let mut frame_times: Vec<f32> = weights.iter().flatten().map(|w| w.0).chain(scales.iter().flatten().map(|s| s.0)).collect();
+    frame_times.sort_by(f32::total_cmp);
+    frame_times.dedup();
+    assert!(frame_times.len() >= 6, "{frame_times:?}");
+    let mut last = Vec::new();
+    for &t in &frame_times {
+        let shown: Vec<usize> = (0..2).filter(|&n| scale_at(n, t) == [1.0; 3]).collect();
+        assert_eq!(shown.len(), 1, "at t = {t} s exactly one mesh shows: {shown:?}");
+        assert!((0..2).all(|n| matches!(scale_at(n, t), [1.0, 1.0, 1.0] | [0.0, 0.0, 0.0])));
+        let node = shown[0];
+        let primitive = nodes[node].mesh().unwrap().primitives().next().unwrap();
+        let frame_weights = weights[node].iter().find(|w| w.0 == t).map(|w| w.1.clone()).unwrap_or_default();
+        let positions = morphed(&primitive, &blob, &frame_weights);
+        // On or around the form: finite, above the floor, within a metre of its axis.
+        assert!(positions.iter().all(|p| p.iter().all(|c| c.is_finite()) && p[1] > 0.0 && p[0].abs() < 1.0 && p[2].abs() < 1.0), "t = {t}");
+        last = positions;
+    }
+    let s = read(&still);
+    assert_eq!(last.len(), s.positions.len(), "the last frame is on the welded mesh");
+    for (p, q) in last.iter().zip(&s.positions) {
+        for k in 0..3 {
+            assert!((p[k] - q[k]).abs() < 1e-5, "{p:?} against the still's {q:?}");
+        }
+    }
+}

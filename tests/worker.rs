@@ -96,7 +96,8 @@ fn step_and_reset() {
     let start = worker.latest();
     assert_eq!((start.steps, start.time, start.playing), (0, 0.0, false));
     assert_eq!(start.positions.len(), start.stats.vertices);
-    assert_eq!(start.triangles.len(), start.stats.triangles);
+    assert_eq!(start.topology.triangles.len(), start.stats.triangles);
+    assert!(start.topology.fits(&start.positions));
     for _ in 0..3 {
         worker.send(Command::Step);
     }
@@ -228,7 +229,7 @@ fn dragged_vertex_follows_the_target_and_is_released() {
     // The free corner farthest from the clamp.
     let tip = (0..start.positions.len()).max_by(|&a, &b| start.positions[a].x.total_cmp(&start.positions[b].x)).unwrap() as u32;
     let target = start.positions[tip as usize] + DVec3::new(0.0, 0.0, 0.01);
-    worker.send(Command::DragVertex { vertex: tip, target });
+    worker.send(Command::DragVertex { vertex: tip, mesh: start.topology.version, target });
     for _ in 0..40 {
         worker.send(Command::Step);
     }
@@ -246,7 +247,7 @@ fn dragged_vertex_follows_the_target_and_is_released() {
     assert!(released.positions[tip as usize].z < target.z, "gravity takes it back down");
     // A clamped vertex is not taken from its clamp.
     let clamped = start.fixed.iter().position(|&f| f).unwrap() as u32;
-    worker.send(Command::DragVertex { vertex: clamped, target: DVec3::ONE });
+    worker.send(Command::DragVertex { vertex: clamped, mesh: start.topology.version, target: DVec3::ONE });
     worker.send(Command::Step);
     let snapshot = worker.sync(WAIT);
     assert_eq!(snapshot.dragged, None);
@@ -294,4 +295,98 @@ fn step_time_and_real_time_factor_come_from_one_clock() {
         assert!(busy > 0.5, "playing flat out, the steps took only {busy} of the window: {s:?}");
     }
     worker.send(Command::Pause);
+}
+
+/// The viewer died at the first frame after a garment's seams welded: the weld merges
+/// the seams' vertices, the triangles keep their count, and the snapshots went on carrying
+/// the unwelded mesh's triangles. Every snapshot of a garment stepped through its weld
+/// carries the mesh its positions belong to, and the frame drawn from it is whole; a vertex
+/// the mouse held across the weld is held at its merged vertex, and let go after it, it is
+/// not left pinned.
+#[test]
+fn a_garment_welds_under_the_worker_and_every_snapshot_fits_its_mesh() {
+    let (mut config, _) = load_scene("skirt-gored-bias", &["mesh.edge_length=0.035".into()]).unwrap();
+    config.solver.path = rosette::settings::SolverPath::Fast;
+    let worker = spawn("skirt-gored-bias", config);
+    let start = worker.latest();
+    // A free vertex on a seam line's side, held still by the mouse while the seams close.
+    let held = (0..start.positions.len()).find(|&v| !start.fixed[v]).unwrap() as u32;
+    worker.send(Command::DragVertex { vertex: held, mesh: start.topology.version, target: start.positions[held as usize] });
+    let mut welded = None;
+    for _ in 0..400 {
+        worker.send(Command::Step);
+        let snapshot = worker.sync(WAIT);
+        assert!(snapshot.error.is_none(), "{:?}", snapshot.error);
+        assert!(snapshot.topology.fits(&snapshot.positions), "{} positions for a mesh of {}", snapshot.positions.len(), snapshot.topology.vertex_count);
+        assert_eq!(snapshot.fixed.len(), snapshot.positions.len());
+        let topology = &snapshot.topology;
+        let frame = rosette::render::Frame::from_cloth(&snapshot.positions, &topology.triangles, &topology.texture, topology.warp_angle);
+        assert!(frame.cloth_is_whole());
+        if snapshot.sewing.is_some_and(|s| s.sewn_at.is_some()) {
+            welded = Some(snapshot);
+            break;
+        }
+    }
+    let welded = welded.expect("the skirt is sewn within 400 steps");
+    assert!(welded.positions.len() < start.positions.len(), "the weld merged vertices");
+    assert_ne!(welded.topology.version, start.topology.version);
+    let (from, map) = welded.topology.merged_from.as_ref().expect("a weld says where its vertices came from");
+    assert_eq!(*from, start.topology.version);
+    let merged = map[held as usize];
+    assert_eq!(welded.dragged, Some(merged), "the mouse holds the merged vertex");
+    worker.send(Command::ReleaseDrag);
+    worker.send(Command::Step);
+    let released = worker.sync(WAIT);
+    assert_eq!(released.dragged, None);
+    assert!(!released.fixed[merged as usize], "the weld does not keep the mouse's hold as a pin");
+    // A drag picked on the unwelded mesh is carried; one on an unrelated mesh is dropped.
+    worker.send(Command::DragVertex { vertex: held, mesh: start.topology.version, target: released.positions[merged as usize] });
+    worker.send(Command::Step);
+    assert_eq!(worker.sync(WAIT).dragged, Some(merged));
+    worker.send(Command::DragVertex { vertex: 0, mesh: u64::MAX, target: DVec3::ZERO });
+    worker.send(Command::Step);
+    assert_eq!(worker.sync(WAIT).dragged, None, "an index from a mesh the cloth no longer has names nothing");
+}
+
+/// A new fabric or new grains on a sewn garment re-drape it where it hangs: the same mesh,
+/// the same positions to start from, the clock going on; a scene opened afresh sews from
+/// flat panels.
+#[test]
+fn a_sewn_garment_re_drapes_in_a_new_fabric_and_grain() {
+    let (mut config, _) = load_scene("skirt-gored-bias", &["mesh.edge_length=0.035".into()]).unwrap();
+    config.solver.path = rosette::settings::SolverPath::Fast;
+    let worker = spawn("skirt-gored-bias", config.clone());
+    let mut sewn = None;
+    for _ in 0..400 {
+        worker.send(Command::Step);
+        let snapshot = worker.sync(WAIT);
+        if snapshot.sewing.is_some_and(|s| s.sewn_at.is_some()) {
+            sewn = Some(snapshot);
+            break;
+        }
+    }
+    let sewn = sewn.expect("sewn within 400 steps");
+    let mut silk = sewn.config.fabric.clone();
+    silk.properties.areal_density *= 0.5;
+    silk.name = "lighter".into();
+    worker.send(Command::SetFabric(Box::new(silk)));
+    let refabric = worker.sync(WAIT);
+    assert!(refabric.error.is_none(), "{:?}", refabric.error);
+    assert!(refabric.drape.from_sewn);
+    assert_eq!(refabric.topology.version, sewn.topology.version, "the same mesh and texture: the same topology");
+    assert_eq!(bits(&refabric.positions), bits(&sewn.positions), "it starts where it hung");
+    assert_eq!(refabric.time, sewn.time);
+    assert!(refabric.sewing.unwrap().sewn_at.is_some());
+    // Other grains: the same mesh, its texture turned, the vertices' indices kept.
+    worker.send(Command::SetGrains(vec![90.0; 4]));
+    let regrained = worker.sync(WAIT);
+    assert!(regrained.drape.from_sewn);
+    assert_eq!(regrained.positions.len(), sewn.positions.len());
+    assert_ne!(regrained.topology.version, sewn.topology.version);
+    assert_eq!(regrained.topology.merged_from.as_ref().unwrap().0, refabric.topology.version);
+    worker.send(Command::LoadScene { name: "skirt".into(), config: Box::new(config) });
+    worker.send(Command::Step);
+    let reloaded = worker.sync(WAIT);
+    assert!(!reloaded.drape.from_sewn);
+    assert!(reloaded.sewing.unwrap().sewn_at.is_none(), "a scene opened afresh sews from flat panels");
 }

@@ -37,6 +37,9 @@ pub struct Ray {
 
 const PITCH_LIMIT: f64 = 89.0 * std::f64::consts::PI / 180.0;
 
+/// How far the camera turns per pixel the mouse moves, radians.
+const ORBIT_PER_PIXEL: f64 = 0.008;
+
 impl Default for OrbitCamera {
     fn default() -> Self {
         Self { target: DVec3::ZERO, yaw: -60f64.to_radians(), pitch: 30f64.to_radians(), distance: 0.3, fov_y: 40f64.to_radians() }
@@ -79,8 +82,14 @@ impl OrbitCamera {
 
     /// Turns the camera by a mouse movement of (dx, dy) pixels.
     pub fn orbit(&mut self, dx: f64, dy: f64) {
-        self.yaw -= dx * 0.008;
-        self.pitch = (self.pitch + dy * 0.008).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+        self.turn(-dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
+    }
+
+    /// Turns the camera about its target by `yaw` (about z) and `pitch` (up), radians; the
+    /// elevation stays within ±89°.
+    pub fn turn(&mut self, yaw: f64, pitch: f64) {
+        self.yaw += yaw;
+        self.pitch = (self.pitch + pitch).clamp(-PITCH_LIMIT, PITCH_LIMIT);
     }
 
     /// Slides the target with the mouse by (dx, dy) pixels of a view `height` pixels tall, so

@@ -32,6 +32,18 @@ impl ColourMap {
         }
     }
 
+    /// The name a script or the command line gives it: `fabric`, or the renderer's
+    /// `--colormap` name.
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::Fabric => "fabric",
+            Self::WarpStrain => "warp",
+            Self::WeftStrain => "weft",
+            Self::Shear => "shear",
+            Self::Bending => "bending",
+        }
+    }
+
     /// Signed fields use a diverging scale centred on zero.
     pub fn signed(self) -> bool {
         matches!(self, Self::WarpStrain | Self::WeftStrain | Self::Shear)
@@ -70,12 +82,13 @@ pub fn field(snapshot: &Snapshot, map: ColourMap) -> Option<Field> {
             snapshot.triangle_curvatures.iter().map(|c| (c[0] * c[0] + c[1] * c[1] + 2.0 * c[2] * c[2]).sqrt()).collect()
         }
     };
-    if per_triangle.len() != snapshot.triangles.len() {
+    let topology = &snapshot.topology;
+    if per_triangle.len() != topology.triangles.len() || !topology.fits(&snapshot.positions) {
         return None;
     }
-    let n = snapshot.positions.len();
+    let n = topology.vertex_count;
     let (mut sum, mut count) = (vec![0.0f32; n], vec![0u32; n]);
-    for (tri, value) in snapshot.triangles.iter().zip(&per_triangle) {
+    for (tri, value) in topology.triangles.iter().zip(&per_triangle) {
         for &v in tri {
             sum[v as usize] += value;
             count[v as usize] += 1;

@@ -8,6 +8,8 @@
 //!   [`chart_view`]: the speed/accuracy charts of `rosette chart`; [`card_view`]: the
 //!   fabric card of the fabric being edited; [`pin`]: a fabric's result kept beside the live
 //!   one; [`pattern_view`]: a garment's grains and its flat pattern.
+//! - [`script`]: scripted sessions read and checked; [`session`]: one played in the window
+//!   through the panels' own code.
 pub mod camera;
 pub mod card_view;
 pub mod chart_view;
@@ -16,6 +18,8 @@ pub mod files;
 pub mod pattern_view;
 pub mod pin;
 pub mod plots;
+pub mod script;
+pub mod session;
 pub mod ui;
 pub mod worker;
 pub mod viewer;

@@ -58,13 +58,12 @@ impl PatternView {
         ui.horizontal(|ui| {
             ui.label("cut");
             let cut = cut_of(&self.grains);
-            for (label, target, grain, hover) in [
-                ("straight", Cut::Straight, STRAIGHT_GRAIN, "every panel's warp down its centre line (grain 90°)"),
-                ("bias", Cut::Bias, BIAS_GRAIN, "every panel's warp at 45° to its centre line: soft in tension and shear, it hangs closer"),
+            for (label, target, hover) in [
+                ("straight", Cut::Straight, "every panel's warp down its centre line (grain 90°)"),
+                ("bias", Cut::Bias, "every panel's warp at 45° to its centre line: soft in tension and shear, it hangs closer"),
             ] {
                 if ui.selectable_label(cut == target, label).on_hover_text(hover).clicked() && cut != target {
-                    self.set_grains(vec![grain; self.grains.len()], garment);
-                    actions.push(Action::Send(Command::SetGrains(self.grains.clone())));
+                    self.cut(target, garment, actions);
                 }
             }
             if cut == Cut::Mixed {
@@ -75,7 +74,7 @@ impl PatternView {
         egui::Grid::new("grains").num_columns(2).show(ui, |ui| {
             for (panel, grain) in garment.panels.iter().zip(&mut edited) {
                 ui.label(&panel.name);
-                ui.add(egui::DragValue::new(grain).range(-180.0..=180.0).speed(1.0).suffix("° grain"))
+                ui.add(egui::DragValue::new(grain).range(-360.0..=360.0).speed(1.0).suffix("° grain"))
                     .on_hover_text("the warp's angle from the panel's x axis: 90 straight, 45 or 135 bias");
                 ui.end_row();
             }
@@ -85,11 +84,56 @@ impl PatternView {
         }
         ui.horizontal(|ui| {
             let changed = self.grains != scene_grains;
-            if ui.add_enabled(changed, egui::Button::new("Recut")).on_hover_text("cut, place and sew the panels again on these grains").clicked() {
-                actions.push(Action::Send(Command::SetGrains(self.grains.clone())));
+            if ui
+                .add_enabled(changed, egui::Button::new("Recut"))
+                .on_hover_text("cut the panels again on these grains: a sewn garment re-drapes where it hangs")
+                .clicked()
+            {
+                self.recut(snapshot, actions);
             }
             ui.toggle_value(&mut self.open, "Flat pattern").on_hover_text("the panels as cut, their grain lines and seams");
         });
+    }
+
+    /// The straight / bias switch: every panel recut on `cut` at once.
+    fn cut(&mut self, cut: Cut, garment: &GarmentConfig, actions: &mut Vec<Action>) {
+        let grain = match cut {
+            Cut::Straight => STRAIGHT_GRAIN,
+            Cut::Bias => BIAS_GRAIN,
+            Cut::Mixed => return,
+        };
+        self.set_grains(vec![grain; self.grains.len()], garment);
+        actions.push(Action::Send(Command::SetGrains(self.grains.clone())));
+    }
+
+    /// The straight / bias switch, clicked for `snapshot`'s garment; nothing where the
+    /// garment is already cut so.
+    pub fn choose_cut(&mut self, cut: Cut, snapshot: &Snapshot, actions: &mut Vec<Action>) -> Result<(), String> {
+        let garment = snapshot.config.garment.as_ref().ok_or("the scene is not a garment: it has no pattern to recut")?;
+        self.follow(garment, snapshot.scene_generation);
+        if cut_of(&self.grains) != cut {
+            self.cut(cut, garment, actions);
+        }
+        Ok(())
+    }
+
+    /// A panel's grain typed into the editor, degrees (not yet recut).
+    pub fn edit_grain(&mut self, panel: &str, degrees: f64, snapshot: &Snapshot) -> Result<(), String> {
+        let garment = snapshot.config.garment.as_ref().ok_or("the scene is not a garment: it has no panels")?;
+        self.follow(garment, snapshot.scene_generation);
+        let index = garment.panels.iter().position(|p| p.name == panel).ok_or_else(|| format!("no panel '{panel}'"))?;
+        let mut grains = self.grains.clone();
+        grains[index] = degrees;
+        self.set_grains(grains, garment);
+        Ok(())
+    }
+
+    /// *Recut*: the grains being edited go to the worker, where they differ from the scene's.
+    pub fn recut(&mut self, snapshot: &Snapshot, actions: &mut Vec<Action>) {
+        let Some(garment) = &snapshot.config.garment else { return };
+        if garment.panels.iter().map(|p| p.grain_deg).ne(self.grains.iter().copied()) {
+            actions.push(Action::Send(Command::SetGrains(self.grains.clone())));
+        }
     }
 
     /// Takes the scene's grains when the scene is rebuilt.

@@ -12,7 +12,7 @@ use super::colour::ColourMap;
 use super::plots::{self, History};
 use super::worker::{Command, Snapshot};
 use crate::settings::{FABRICS, FabricConfig, SCENES, scene_descriptions};
-use crate::scene::load_scene;
+use crate::scene::{SceneConfig, load_scene};
 use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use egui::{Color32, Key, PointerButton, Rect, Sense};
@@ -35,6 +35,8 @@ pub enum Action {
     /// A file to pick, then read or write.
     File(FileDialog),
     Screenshot,
+    /// Save the window, as F12 does, to this file (a scripted session's screenshot).
+    SaveScreenshot(std::path::PathBuf),
     /// Keep the current fabric's picture and measures beside the live view.
     Pin,
 }
@@ -57,6 +59,10 @@ pub enum FileDialog {
 #[derive(Debug, Clone, Copy)]
 struct MouseDrag {
     vertex: u32,
+    /// The version of the mesh `vertex` indexes (`Topology::version`).
+    mesh: u64,
+    /// The cloth was rebuilt under the drag: the rest of the gesture moves nothing.
+    lost: bool,
     /// Where the ray first met the cloth, m.
     hit: DVec3,
     /// The vertex's position then, m.
@@ -77,7 +83,11 @@ pub struct ViewerUi {
     pub messages: Vec<String>,
     /// The last thing done that has no other feedback (a file saved).
     pub notice: Option<String>,
-    framed_scene: Option<(String, usize)>,
+    framed_scene: Option<String>,
+    /// The mesh the view last saw, and whether the user has turned, panned or zoomed the
+    /// camera since the scene was framed.
+    framed_mesh: Option<u64>,
+    camera_moved: bool,
     fabric: Option<FabricConfig>,
     fabric_generation: u64,
     fabric_pending: bool,
@@ -109,6 +119,8 @@ impl Default for ViewerUi {
             messages: Vec::new(),
             notice: None,
             framed_scene: None,
+            framed_mesh: None,
+            camera_moved: false,
             fabric: None,
             fabric_generation: 0,
             fabric_pending: false,
@@ -149,11 +161,18 @@ impl ViewerUi {
 
     /// Frames the camera on a new scene and takes the scene's fabric into the editor.
     fn follow_scene(&mut self, snapshot: &Snapshot) {
-        let key = (snapshot.scene_name.clone(), snapshot.positions.len());
+        // A new scene is framed; a reset, a new fabric or a finer level keeps the user's
+        // view. A garment's flat panels start far out round the form: once its seams weld,
+        // a view the user has not moved is framed again on the sewn garment.
+        let key = snapshot.scene_name.clone();
         if self.framed_scene.as_ref() != Some(&key) {
             self.camera.frame(&snapshot.positions);
             self.framed_scene = Some(key);
+            self.camera_moved = false;
+        } else if !self.camera_moved && self.framed_mesh.is_some_and(|m| snapshot.topology.merged_from.as_ref().is_some_and(|(from, _)| *from == m)) {
+            self.camera.frame(&snapshot.positions);
         }
+        self.framed_mesh = Some(snapshot.topology.version);
         if snapshot.scene_generation != self.fabric_generation && !self.fabric_pending {
             self.fabric = Some(snapshot.config.fabric.clone());
             self.fabric_generation = snapshot.scene_generation;
@@ -215,6 +234,9 @@ impl ViewerUi {
             }
             ui.separator();
             ui.monospace(format!("t = {:.3} / {} s   step {}", snapshot.time, snapshot.duration, snapshot.steps));
+            if let Some((text, colour)) = drape_status(snapshot) {
+                ui.colored_label(colour, text);
+            }
             match (snapshot.finished, snapshot.settled_at) {
                 (true, Some(t)) => {
                     ui.label(format!("(settled at t = {t:.2} s: Play continues)"));
@@ -305,7 +327,7 @@ impl ViewerUi {
         ui.separator();
         self.solver_panel(ui, snapshot, actions);
         ui.separator();
-        self.fabric_panel(ui, &snapshot.scene_name);
+        self.fabric_panel(ui, &snapshot.config);
     }
 
     fn solver_panel(&mut self, ui: &mut egui::Ui, snapshot: &Snapshot, actions: &mut Vec<Action>) {
@@ -332,9 +354,7 @@ impl ViewerUi {
                      drape coefficients stay within about 0.01 of the exact path's seed scatter (docs/fast-path.md).",
                 );
             });
-            if path != snapshot.config.solver.path {
-                actions.push(Action::Send(Command::SetPath(path)));
-            }
+            self.choose_path(path, snapshot, actions);
             ui.end_row();
         });
         if dt != snapshot.config.solver.dt || integrator != snapshot.config.solver.integrator {
@@ -348,31 +368,26 @@ impl ViewerUi {
         }
     }
 
-    fn fabric_panel(&mut self, ui: &mut egui::Ui, scene: &str) {
+    fn fabric_panel(&mut self, ui: &mut egui::Ui, scene: &SceneConfig) {
         ui.heading("Fabric");
-        let Some(fabric) = &mut self.fabric else { return };
-        let mut changed = false;
+        let Some(fabric) = &self.fabric else { return };
+        let mut chosen = None;
         egui::ComboBox::from_id_salt("fabric_preset")
             .selected_text(format!("start from: {}", fabric.preset.as_deref().unwrap_or("(custom)")))
             .show_ui(ui, |ui| {
                 for bundled in FABRICS {
                     if ui.selectable_label(false, bundled.name).clicked() {
-                        match crate::fabric::parse_fabric(bundled.text, bundled.name).map(|loaded| loaded.config) {
-                            Ok(mut f) => {
-                                f.preset = Some(bundled.name.to_string());
-                                // As the scene runs it (`--set fabric.preset=NAME`): a drape
-                                // scene's own fabric keys stay.
-                                match crate::card::scene_fabric(scene, &f) {
-                                    Ok(f) => *fabric = f,
-                                    Err(e) => self.messages.push(format!("fabric {}: {e}", bundled.name)),
-                                }
-                                changed = true;
-                            }
-                            Err(e) => self.messages.push(format!("fabric {}: {e}", bundled.name)),
-                        }
+                        chosen = Some(bundled.name);
                     }
                 }
             });
+        if let Some(name) = chosen
+            && let Err(e) = self.choose_fabric(name, scene)
+        {
+            self.messages.push(e);
+        }
+        let Some(fabric) = &mut self.fabric else { return };
+        let mut changed = false;
         // Rigidities are shown in µN·m, the size they come in.
         let micro = |v: &mut f64| *v * 1e6;
         let (mut bending_warp, mut bending_weft) = (micro(&mut fabric.properties.bending_warp), micro(&mut fabric.properties.bending_weft));
@@ -433,6 +448,48 @@ impl ViewerUi {
         self.fabric_pending = false;
     }
 
+    /// Takes the bundled fabric `name` into the editor as the scene `scene` runs it
+    /// (`--set fabric.preset=NAME`: a drape scene's own fabric keys stay) and applies it:
+    /// what choosing it in the fabric list does.
+    pub fn choose_fabric(&mut self, name: &str, scene: &SceneConfig) -> Result<(), String> {
+        let bundled = FABRICS.iter().find(|f| f.name == name).ok_or_else(|| format!("no bundled fabric '{name}'"))?;
+        let mut fabric = crate::fabric::parse_fabric(bundled.text, bundled.name).map_err(|e| format!("fabric {name}: {e}"))?.config;
+        fabric.preset = Some(bundled.name.to_string());
+        let fabric = crate::card::scene_fabric(scene, &fabric).map_err(|e| format!("fabric {name}: {e}"))?;
+        self.set_fabric(fabric);
+        Ok(())
+    }
+
+    /// Whether a fabric edit waits to be sent to the worker.
+    pub fn fabric_pending(&self) -> bool {
+        self.fabric_pending
+    }
+
+    /// The solver path switch.
+    pub fn choose_path(&mut self, path: SolverPath, snapshot: &Snapshot, actions: &mut Vec<Action>) {
+        if path != snapshot.config.solver.path {
+            actions.push(Action::Send(Command::SetPath(path)));
+        }
+    }
+
+    /// A fabric test's button: the bundled test `name` runs on the fabric being edited.
+    pub fn run_test(&mut self, name: &str, actions: &mut Vec<Action>) {
+        actions.push(Action::Send(Command::RunTest(name.to_string())));
+    }
+
+    /// Turns the camera about the cloth by `yaw` and `pitch` (radians), as an orbiting drag
+    /// does.
+    pub fn turn_camera(&mut self, yaw: f64, pitch: f64) {
+        self.camera.turn(yaw, pitch);
+        self.camera_moved = true;
+    }
+
+    /// Brings the camera `factor` times closer (below 1: farther), as the wheel does.
+    pub fn zoom_camera(&mut self, factor: f64) {
+        self.camera.zoom(10.0 * factor.ln());
+        self.camera_moved = true;
+    }
+
     /// Replaces the fabric under edit (e.g. from a file) and applies it.
     pub fn set_fabric(&mut self, fabric: FabricConfig) {
         self.fabric = Some(fabric);
@@ -452,7 +509,7 @@ impl ViewerUi {
         ui.horizontal_wrapped(|ui| {
             for name in TESTS.iter().filter(|n| SCENES.iter().any(|s| s.name == **n)) {
                 if ui.button(*name).clicked() {
-                    actions.push(Action::Send(Command::RunTest(name.to_string())));
+                    self.run_test(name, actions);
                 }
             }
         });
@@ -502,6 +559,16 @@ impl ViewerUi {
                 row("quasi-Newton iterations", format!("{}", s.quasi_newton_iterations));
             }
             row("Newton / CG iterations", format!("{} / {}", s.newton_iterations, s.cg_iterations));
+            let clock = snapshot.drape;
+            let waited = match clock.settled {
+                Some((_, wall)) => format!("settled {wall:.1} s after the {}", clock.cause.name()),
+                None => format!("{:.1} s since the {}, not settled", clock.wall, clock.cause.name()),
+            };
+            row("drape", waited);
+            if let Some(factor) = clock.real_time_factor_since_weld() {
+                let from = if snapshot.sewing.is_some() && !clock.from_sewn { "the weld".to_string() } else { format!("the {}", clock.cause.name()) };
+                row(&format!("real-time factor from {from}"), format!("{factor:.2}"));
+            }
             row("kinetic energy", format!("{:.4e} J", s.kinetic_energy));
             row("membrane energy", format!("{:.4e} J", s.membrane_energy));
             row("bending energy", format!("{:.4e} J", s.bending_energy));
@@ -525,42 +592,73 @@ impl ViewerUi {
         {
             let (x, y) = local(pos);
             let ray = self.camera.ray(x, y, w, h);
-            if let Some((vertex, hit)) = ray.pick_vertex(&snapshot.positions, &snapshot.triangles)
+            if let Some((vertex, hit)) = ray.pick_vertex(&snapshot.positions, &snapshot.topology.triangles)
                 && !snapshot.fixed[vertex as usize]
             {
                 let start = snapshot.positions[vertex as usize];
-                self.mouse_drag = Some(MouseDrag { vertex, hit, start, normal: -self.camera.basis().0 });
-                actions.push(Action::Send(Command::DragVertex { vertex, target: start }));
+                let mesh = snapshot.topology.version;
+                self.mouse_drag = Some(MouseDrag { vertex, mesh, lost: false, hit, start, normal: -self.camera.basis().0 });
+                actions.push(Action::Send(Command::DragVertex { vertex, mesh, target: start }));
+            }
+        }
+        // The mesh changed under the mouse: a weld carries the held point to its merged
+        // vertex; another mesh lets it go (the worker has let go too).
+        if let Some(drag) = &mut self.mouse_drag
+            && drag.mesh != snapshot.topology.version
+        {
+            match snapshot.topology.carry_vertex(drag.mesh, drag.vertex) {
+                Some(vertex) => (drag.vertex, drag.mesh) = (vertex, snapshot.topology.version),
+                None => drag.lost = true,
             }
         }
         if response.dragged_by(PointerButton::Primary) {
             match (self.mouse_drag, response.interact_pointer_pos()) {
+                (Some(drag), _) if drag.lost => {}
                 (Some(drag), Some(pos)) => {
                     let (x, y) = local(pos);
                     if let Some(point) = self.camera.ray(x, y, w, h).hit_plane(drag.hit, drag.normal) {
-                        actions.push(Action::Send(Command::DragVertex { vertex: drag.vertex, target: drag.start + (point - drag.hit) }));
+                        let target = drag.start + (point - drag.hit);
+                        actions.push(Action::Send(Command::DragVertex { vertex: drag.vertex, mesh: drag.mesh, target }));
                     }
                 }
                 _ => {
                     let d = response.drag_delta();
                     self.camera.orbit(f64::from(d.x), f64::from(d.y));
+                    self.camera_moved = true;
                 }
             }
         }
         if response.dragged_by(PointerButton::Secondary) || response.dragged_by(PointerButton::Middle) {
             let d = response.drag_delta();
             self.camera.pan(f64::from(d.x), f64::from(d.y), h);
+            self.camera_moved = true;
         }
-        if response.drag_stopped() && self.mouse_drag.take().is_some() {
+        if response.drag_stopped() && self.mouse_drag.take().is_some_and(|d| !d.lost) {
             actions.push(Action::Send(Command::ReleaseDrag));
         }
         if response.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
             if scroll != 0.0 {
                 self.camera.zoom(f64::from(scroll) / 50.0);
+                self.camera_moved = true;
             }
         }
     }
+}
+
+/// What the drape is doing, in words, for the toolbar: a garment sewing, settling or
+/// settled (with the wall time from the click), and its colour.
+fn drape_status(snapshot: &Snapshot) -> Option<(String, Color32)> {
+    let sewing = snapshot.sewing?;
+    let clock = snapshot.drape;
+    let (amber, green, red) = (Color32::from_rgb(230, 180, 70), Color32::from_rgb(130, 210, 130), Color32::from_rgb(255, 110, 100));
+    Some(match (sewing.sewn_at, clock.settled) {
+        (None, _) if sewing.failed => ("not sewn: a seam was still open at the sewing time".into(), red),
+        (None, _) => (format!("sewing: seams {:.1} mm apart", 1e3 * sewing.open_gap), amber),
+        (Some(_), Some((_, wall))) => (format!("settled in {wall:.1} s after the {}", clock.cause.name()), green),
+        (Some(_), None) if clock.from_sewn => (format!("re-draping from the sewn garment ({:.1} s)", clock.wall), amber),
+        (Some(at), None) => (format!("settling (sewn at t = {at:.2} s, {:.1} s ago)", clock.wall - clock.sewn.map_or(0.0, |s| s.1)), amber),
+    })
 }
 
 /// A drag value whose step is half a percent of its size, for quantities spanning decades.

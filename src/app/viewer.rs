@@ -8,9 +8,11 @@
 use super::colour::{self, ColourMap};
 use super::files;
 use crate::render::{self, ColorMap, Frame, PropMesh, RenderOptions, ScalarField};
+use super::script::Script;
+use super::session::{Control, FrameInput, Session};
 use super::ui::{Action, FileDialog, ViewerUi};
 use super::worker::{Command, Snapshot, Worker};
-use crate::scene::load_scene;
+use crate::scene::{SceneConfig, load_scene};
 use crate::settings::SCENES;
 use anyhow::{Context, anyhow};
 use egui_wgpu::wgpu;
@@ -31,6 +33,19 @@ pub struct ViewerOptions {
     pub quit_after_frames: Option<u64>,
     /// `KEY=VALUE` overrides of the first scene, as `rosette run --set` takes them.
     pub overrides: Vec<String>,
+    /// The first scene, already loaded and checked (else `preset` and `overrides` are).
+    pub config: Option<SceneConfig>,
+    /// A scripted session, read and checked, played from the first frame.
+    pub script: Option<Script>,
+    /// Where the session's report is written (JSON), once it ends.
+    pub report: Option<PathBuf>,
+}
+
+/// Loads the scene the viewer opens on, on the path it opens on (`plan::opening_path`).
+pub fn load_first_scene(spec: &str, overrides: &[String]) -> Result<SceneConfig, String> {
+    let (mut config, _) = load_scene(spec, overrides).map_err(|e| e.to_string())?;
+    config.solver.path = crate::scene::plan::opening_path(&config);
+    Ok(config)
 }
 
 /// The scene the viewer opens on: the Cusick drape where it exists, else Euler buckling.
@@ -52,13 +67,17 @@ pub const NO_DISPLAY: &str = "no display: neither DISPLAY nor WAYLAND_DISPLAY is
 #[derive(Debug, Clone, Copy)]
 struct Wake;
 
-/// Opens the viewer and runs until its window closes.
-pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
+/// Opens the viewer and runs until its window closes or its session ends. Returns the
+/// session's exit code (0 without a session, or when it ran to its end).
+pub fn run(mut options: ViewerOptions) -> anyhow::Result<u8> {
     if !display_available() {
         return Err(anyhow!(NO_DISPLAY));
     }
     let spec = options.preset.clone().unwrap_or_else(|| default_scene().to_string());
-    let (config, _) = load_scene(&spec, &options.overrides).map_err(|e| anyhow!("{e}"))?;
+    let config = match options.config.take() {
+        Some(config) => config,
+        None => load_first_scene(&spec, &options.overrides).map_err(|e| anyhow!("{e}"))?,
+    };
     let event_loop = EventLoop::<Wake>::with_user_event()
         .build()
         .map_err(|e| anyhow!("cannot connect to the display ({e}). {NO_DISPLAY}"))?;
@@ -73,7 +92,10 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
         event_loop.owned_display_handle(),
     )));
     let (dialog_tx, dialog_rx) = channel();
+    let session = options.script.take().map(Session::new);
     let mut app = App {
+        session,
+        outcome: Control::Continue,
         options,
         worker,
         ui: ViewerUi::default(),
@@ -88,12 +110,14 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
         dialog_open: false,
         screenshot: None,
         next_repaint: None,
+        last_frame: None,
+        want_frame: None,
     };
     event_loop.run_app(&mut app).context("the window's event loop failed")?;
-    match app.fatal {
-        Some(e) => Err(e),
-        None => Ok(()),
+    if let Some(e) = app.fatal {
+        return Err(e);
     }
+    app.finish_session()
 }
 
 /// A preset name as typed, or a file's stem.
@@ -118,6 +142,9 @@ struct Gpu {
 
 struct App {
     options: ViewerOptions,
+    /// The scripted session being played, if any, and how it ended.
+    session: Option<Session>,
+    outcome: Control,
     worker: Worker,
     ui: ViewerUi,
     egui: egui::Context,
@@ -135,6 +162,10 @@ struct App {
     /// When egui asked for its next frame (an animation, the chart's progress bar), if it
     /// asked for one later rather than at once.
     next_repaint: Option<std::time::Instant>,
+    /// When the last frame was done, and how long it took to draw.
+    last_frame: Option<(std::time::Instant, std::time::Duration)>,
+    /// The next frame the one being drawn asks for (scheduled once it is done).
+    want_frame: Option<std::time::Instant>,
 }
 
 impl ApplicationHandler<Wake> for App {
@@ -170,16 +201,19 @@ impl ApplicationHandler<Wake> for App {
         }
     }
 
+    /// A new snapshot (or a dialog's answer): drawn as soon as drawing may take its share of
+    /// the time again ([`App::schedule`]), whatever is newest then.
     fn user_event(&mut self, _event_loop: &ActiveEventLoop, _event: Wake) {
-        if let Some(gpu) = &self.gpu {
-            gpu.window.request_redraw();
-        }
+        self.schedule(std::time::Instant::now());
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         let Some(gpu) = &mut self.gpu else { return };
         let response = gpu.egui_state.on_window_event(&gpu.window, &event);
-        if response.repaint {
+        // egui asks for a repaint after every event, the redraw itself included: drawn at
+        // once for the user's input, while a redraw's own request would draw frames back to
+        // back (what egui wants after a frame it says with its repaint delay, scheduled).
+        if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
             gpu.window.request_redraw();
         }
         match event {
@@ -196,7 +230,60 @@ impl ApplicationHandler<Wake> for App {
     }
 }
 
+/// The share of the time the window spends drawing frames for new snapshots at most. With
+/// a GPU a frame costs a millisecond or two and every snapshot is drawn; drawn in software
+/// (Mesa's llvmpipe, as under Xvfb) a frame of a 3 000-triangle garment cost about as much
+/// CPU as the physics of its step, and drawing every one doubled the time a garment took to
+/// settle on a two-core machine (docs/performance-log.md, "2026-12-07").
+const DRAW_SHARE: f64 = 0.25;
+
+/// How often a session looks at the scene when nothing else asks for a frame.
+const SESSION_FRAME: std::time::Duration = std::time::Duration::from_millis(50);
+
 impl App {
+    /// Asks for a frame at `due`, or later where drawing would take more than its share of
+    /// the time ([`DRAW_SHARE`]): the frame then waits until the last one's cost is repaid.
+    /// The user's own input (the mouse, keys, a resize) is drawn at once instead.
+    fn schedule(&mut self, due: std::time::Instant) {
+        let earliest = self.last_frame.map(|(end, cost)| end + cost.mul_f64((1.0 - DRAW_SHARE) / DRAW_SHARE));
+        let due = earliest.map_or(due, |e| e.max(due));
+        self.next_repaint = Some(self.next_repaint.map_or(due, |d| d.min(due)));
+        if due <= std::time::Instant::now()
+            && let Some(gpu) = &self.gpu
+        {
+            self.next_repaint = None;
+            gpu.window.request_redraw();
+        }
+    }
+
+    /// Ends the session: its report written where asked, its outcome said on the terminal,
+    /// and its exit code (0 without a session).
+    fn finish_session(&mut self) -> anyhow::Result<u8> {
+        let Some(session) = &self.session else { return Ok(0) };
+        let outcome = match &self.outcome {
+            // The window was closed before the script ended.
+            Control::Continue => Control::Quit,
+            other => other.clone(),
+        };
+        let mut code = match &outcome {
+            Control::Fail(failure) => {
+                crate::errln!("error: {}, line {}: {}", session.script_name(), failure.line, failure.message);
+                failure.code
+            }
+            _ => 0,
+        };
+        if let Some(path) = &self.options.report {
+            let text = session.report(&self.ui, &outcome).to_json();
+            if let Err(e) = crate::io::write::whole(path, text.as_bytes()) {
+                crate::errln!("error: --report {}: cannot write the session's report: {e}", path.display());
+                if code == 0 {
+                    code = super::session::EXIT_NO_OUTPUT;
+                }
+            }
+        }
+        Ok(code)
+    }
+
     fn create_gpu(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<Gpu> {
         let attributes = Window::default_attributes()
             .with_title("Rosette: woven-fabric simulator")
@@ -240,13 +327,26 @@ impl App {
     }
 
     fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        let started = std::time::Instant::now();
+        self.draw(event_loop);
+        self.last_frame = Some((std::time::Instant::now(), started.elapsed()));
+        if let Some(due) = self.want_frame.take() {
+            self.schedule(due);
+        }
+    }
+
+    fn draw(&mut self, event_loop: &ActiveEventLoop) {
         self.poll_dialogs();
         let snapshot = self.worker.latest();
         let Some(gpu) = &mut self.gpu else { return };
-        let input = gpu.egui_state.take_egui_input(&gpu.window);
+        let mut input = gpu.egui_state.take_egui_input(&gpu.window);
         let ui = &mut self.ui;
         let mut actions = Vec::new();
-        let output = self.egui.run_ui(input, |root| actions = ui.show(root, &snapshot));
+        if let (Some(session), Control::Continue) = (&mut self.session, &self.outcome) {
+            let frame = FrameInput { snapshot: &snapshot, ui, events: &mut input.events, actions: &mut actions, commands_sent: self.worker.sent() };
+            self.outcome = session.frame(frame);
+        }
+        let output = self.egui.run_ui(input, |root| actions.extend(ui.show(root, &snapshot)));
         gpu.egui_state.handle_platform_output(&gpu.window, output.platform_output);
         let pixels_per_point = output.pixels_per_point;
         let jobs = self.egui.tessellate(output.shapes, pixels_per_point);
@@ -270,11 +370,18 @@ impl App {
             let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
             encode_frame(gpu, &view, &jobs, &screen, &snapshot, ui);
             gpu.queue.present(frame);
+            // The frame's cost includes the drawing itself, which a software renderer does
+            // on threads of its own after the submit: the next frame's schedule weighs it.
+            let _ = gpu.device.poll(wgpu::PollType::wait_indefinitely());
         }
         if let Some(path) = self.screenshot.take() {
-            match save_screenshot(gpu, &jobs, &screen, &snapshot, ui, &path) {
+            let saved = save_screenshot(gpu, &jobs, &screen, &snapshot, ui, &path).map_err(|e| format!("{e:#}"));
+            match &saved {
                 Ok(()) => ui.notice = Some(format!("saved {}", path.display())),
-                Err(e) => ui.messages.push(format!("screenshot not saved: {e:#}")),
+                Err(e) => ui.messages.push(format!("screenshot not saved: {e}")),
+            }
+            if let (Some(session), Control::Continue) = (&mut self.session, &self.outcome) {
+                self.outcome = session.saved(&path, saved);
             }
         }
         for id in &textures.free {
@@ -282,12 +389,16 @@ impl App {
         }
         textures.clear();
         let repaint_delay = output.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
-        let repaint_now = repaint_delay.is_some_and(|d| d.is_zero());
-        // A later repaint (egui says Duration::MAX for none) is left to about_to_wait.
-        self.next_repaint = repaint_delay
-            .filter(|d| !d.is_zero() && *d < std::time::Duration::from_secs(3600))
-            .map(|d| std::time::Instant::now() + d);
+        // A later repaint (egui says Duration::MAX for none) is scheduled once the frame is
+        // done, as every frame not asked for by the user's input is.
+        self.next_repaint = None;
+        let later = |d: std::time::Duration| (d < std::time::Duration::from_secs(3600)).then(|| std::time::Instant::now() + d);
+        self.want_frame = repaint_delay.and_then(later);
         self.frames += 1;
+        if self.session.is_some() && self.outcome != Control::Continue {
+            event_loop.exit();
+            return;
+        }
         if self.options.quit_after_frames.is_some_and(|n| self.frames >= n) {
             // What a scripted run of the viewer measured: the simulation's pace under the
             // window's own rendering (the toolbar's figures, once, for logs and CI).
@@ -299,8 +410,12 @@ impl App {
             event_loop.exit();
             return;
         }
-        if repaint_now || self.options.quit_after_frames.is_some() {
+        if self.options.quit_after_frames.is_some() {
             gpu.window.request_redraw();
+        } else if self.session.is_some() {
+            // A session's waits look at the clock even while the scene is paused.
+            let due = std::time::Instant::now() + SESSION_FRAME;
+            self.want_frame = Some(self.want_frame.map_or(due, |d| d.min(due)));
         }
         for action in actions {
             self.act(action, &snapshot);
@@ -311,6 +426,11 @@ impl App {
         let dialog = match action {
             Action::Send(command) => {
                 self.worker.send(command);
+                return;
+            }
+            Action::SaveScreenshot(path) => {
+                self.screenshot = Some(path);
+                self.schedule(std::time::Instant::now());
                 return;
             }
             Action::Screenshot => {
@@ -407,16 +527,11 @@ impl App {
                 return Ok(());
             }
             FileDialog::SaveFabric => write(files::fabric_toml(&snapshot.config.fabric)?)?,
-            FileDialog::ExportObj => write(files::mesh_obj(&snapshot.positions, &snapshot.texture, &snapshot.triangles))?,
+            FileDialog::ExportObj => write(files::mesh_obj(&snapshot.positions, &snapshot.topology.texture, &snapshot.topology.triangles))?,
             FileDialog::ExportCsv => write(files::measures_csv(&snapshot.measures, &self.ui.history.names, &self.ui.history.rows))?,
             FileDialog::ExportGltf => {
-                let cloth = crate::export::Cloth {
-                    triangles: &snapshot.triangles,
-                    rest: &snapshot.texture,
-                    warp_angle: snapshot.warp_angle,
-                    name: &snapshot.scene_name,
-                };
-                crate::export::write_glb(path, &cloth, &[(snapshot.time, snapshot.positions.clone())]).map_err(|e| e.to_string())?;
+                let frames = [crate::export::ClothFrame { time: snapshot.time, topology: Arc::clone(&snapshot.topology), positions: snapshot.positions.clone() }];
+                crate::export::write_glb(path, &snapshot.scene_name, &frames).map_err(|e| e.to_string())?;
             }
         }
         self.ui.notice = Some(format!("saved {}", path.display()));
@@ -528,7 +643,8 @@ fn draw_scene(
 /// What the view draws of `snapshot`: the cloth in the chosen colour map, the props and the
 /// floor.
 fn snapshot_frame(snapshot: &Snapshot, ui: &ViewerUi) -> Frame {
-    let mut frame = Frame::from_cloth(&snapshot.positions, &snapshot.triangles, &snapshot.texture, snapshot.warp_angle);
+    let topology = &snapshot.topology;
+    let mut frame = Frame::from_cloth(&snapshot.positions, &topology.triangles, &topology.texture, topology.warp_angle);
     if let (Some(map), Some(field)) = (render_map(ui.colour_map), colour::field(snapshot, ui.colour_map)) {
         frame.cloth_scalar = Some(ScalarField { map, values: field.values, min: field.min, max: field.max });
     }

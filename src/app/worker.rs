@@ -12,7 +12,8 @@
 //! time follows wall time, and when it is slower it runs flat out and reports the
 //! real-time factor. Nothing here depends on a GUI crate, so tests drive it directly.
 
-use crate::scene::{Measures, Scene, SceneConfig, SettleWatch, load_scene};
+use crate::scene::garment::SewingProgress;
+use crate::scene::{Measures, Scene, SceneConfig, SettleWatch, Topology, load_scene};
 use crate::settings::FabricConfig;
 use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
@@ -54,9 +55,13 @@ pub enum Command {
     /// restarts the scene from t = 0, keeping play/pause.
     SetGrains(Vec<f64>),
     /// Holds `vertex` at a point moving towards `target` (m) by at most [`DRAG_SPEED`]·dt
-    /// and half an edge per step, so a fast mouse cannot tear the mesh in one step. A second
-    /// drag of another vertex releases the first.
-    DragVertex { vertex: u32, target: DVec3 },
+    /// and [`DRAG_STEP_EDGES`] of an edge per step, so a fast mouse cannot tear the mesh in
+    /// one step. A second
+    /// drag of another vertex releases the first. `mesh` is the version of the
+    /// [`Topology`] the index was picked on: across a weld the vertex is carried to its
+    /// merged vertex; on an unrelated mesh (a finer level, a rebuilt scene) the command is
+    /// dropped, since the index names another point of the cloth.
+    DragVertex { vertex: u32, mesh: u64, target: DVec3 },
     /// Lets the dragged vertex go with the velocity it had.
     ReleaseDrag,
     /// Loads the bundled laboratory scene `name` with the current fabric and plays it: the
@@ -66,6 +71,12 @@ pub enum Command {
 
 /// Fastest a dragged vertex follows the mouse, m/s.
 pub const DRAG_SPEED: f64 = 1.0;
+
+/// Farthest a dragged vertex moves in one step, in mean edges. The held vertex jumps
+/// there at the step's start while its neighbours start where they were, so the jump is a
+/// strain of about this much on the edges round it: half an edge (50 % strain) took the
+/// fast path's 24 ms garment step 100 Newton iterations; a tenth (10 %) takes a few.
+pub const DRAG_STEP_EDGES: f64 = 0.1;
 
 /// How often a running worker publishes, at most.
 const PUBLISH_INTERVAL: Duration = Duration::from_millis(15);
@@ -114,6 +125,68 @@ pub struct Stats {
     pub worst_residual: f64,
 }
 
+/// What started a drape: the click it answers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DrapeCause {
+    /// The scene was opened (or a test started).
+    #[default]
+    Open,
+    Reset,
+    /// Another fabric.
+    Fabric,
+    /// Panels recut on other grains.
+    Grain,
+    /// The other solver path.
+    Path,
+}
+
+impl DrapeCause {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Open => "open",
+            Self::Reset => "reset",
+            Self::Fabric => "fabric switch",
+            Self::Grain => "recut",
+            Self::Path => "path switch",
+        }
+    }
+}
+
+/// The drape under way, on the wall clock from the click that started it: what a designer
+/// waits for.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DrapeClock {
+    pub cause: DrapeCause,
+    /// Wall seconds since the click.
+    pub wall: f64,
+    /// Simulated time when the drape started, s.
+    pub started_at: f64,
+    /// The drape went on from a sewn garment (a new fabric or grain on the same pattern)
+    /// instead of sewing the panels again.
+    pub from_sewn: bool,
+    /// When the garment was welded during this drape: (simulated s, wall s since the click).
+    pub sewn: Option<(f64, f64)>,
+    /// When the cloth was found settled (the end of the settle window, where play
+    /// pauses): (simulated s, wall s since the click).
+    pub settled: Option<(f64, f64)>,
+    /// Simulated time and wall seconds from the weld on (from the start for a drape that
+    /// needs no sewing), until settling or now: their ratio is the real-time factor a
+    /// designer watches the garment settle at.
+    pub since_weld: (f64, f64),
+    /// Wall seconds the steps themselves took since the click (the rest went to drawing,
+    /// publishing, pacing and pauses).
+    pub stepping: f64,
+}
+
+impl DrapeClock {
+    /// Simulated seconds per wall second from the weld on (None before the weld, or with
+    /// no wall time yet).
+    pub fn real_time_factor_since_weld(&self) -> Option<f64> {
+        let (simulated, wall) = self.since_weld;
+        (wall > 0.0 && simulated > 0.0).then(|| simulated / wall)
+    }
+}
+
 /// What the worker shows the UI: one consistent picture of the simulation.
 #[derive(Debug, Clone)]
 pub struct Snapshot {
@@ -127,15 +200,13 @@ pub struct Snapshot {
     pub scene_name: String,
     /// The configuration of the running scene (fabric and solver as currently set).
     pub config: Arc<SceneConfig>,
-    /// Vertex positions, m.
+    /// Vertex positions, m, one per vertex of `topology`.
     pub positions: Vec<DVec3>,
-    /// Triangles (counter-clockwise in the rest plane), indices into `positions`.
-    pub triangles: Arc<Vec<[u32; 3]>>,
-    /// Texture coordinates, m: the rest plane, or a garment's texture space (each panel in
-    /// its warp frame); `sim::Model::texture_space`.
-    pub texture: Arc<Vec<glam::DVec2>>,
-    /// The warp's angle from the texture coordinates' x axis, radians.
-    pub warp_angle: f64,
+    /// The mesh `positions` belong to: triangles, texture coordinates and a version that
+    /// changes whenever the mesh does (a weld, a finer level, a rebuilt scene). Whatever
+    /// keeps vertex indices between snapshots (a drag, a colour field, a GPU buffer)
+    /// compares the version.
+    pub topology: Arc<Topology>,
     /// Vertices held by the rig (clamps, grips) or the mouse.
     pub fixed: Vec<bool>,
     /// Surfaces of the scene's props (ground planes excepted): positions (m) and triangles.
@@ -163,8 +234,15 @@ pub struct Snapshot {
     pub measures: Arc<Measures>,
     /// The last error (a bad scene or fabric, a diverged step), until the next success.
     pub error: Option<String>,
+    /// The error is a step that diverged (the last good state is shown), not a refused edit.
+    pub diverged: bool,
     /// The vertex held by the mouse, if any.
     pub dragged: Option<u32>,
+    /// A garment's sewing: welded when, or the gap still open (None for other scenes).
+    pub sewing: Option<SewingProgress>,
+    /// The drape under way: what started it and, in wall time since, when the garment was
+    /// sewn and when the cloth settled.
+    pub drape: DrapeClock,
     /// The fast path is on one of its coarser levels (the scene's own mesh comes next).
     pub coarse_level: bool,
 }
@@ -215,6 +293,12 @@ impl Worker {
             let _ = tx.send(command);
         }
         number
+    }
+
+    /// How many commands have been sent so far: a snapshot whose `commands_done` reaches it
+    /// has taken them all.
+    pub fn sent(&self) -> u64 {
+        self.sent.load(Ordering::SeqCst)
     }
 
     /// The newest snapshot (never blocks on physics: the lock is held only to swap an Arc).
@@ -274,8 +358,6 @@ struct WorkerState {
     scene: Scene,
     scene_name: String,
     config: Arc<SceneConfig>,
-    triangles: Arc<Vec<[u32; 3]>>,
-    texture: Arc<Vec<glam::DVec2>>,
     props: Arc<Vec<PropSurface>>,
     ground_z: Option<f64>,
     mailbox: Arc<Mailbox>,
@@ -285,8 +367,15 @@ struct WorkerState {
     finished: bool,
     /// Play has paused where the cloth settled; further play runs on to the end.
     paused_settled: bool,
+    /// The user paused (Pause or Step): an edit that rebuilds the scene does not start it.
+    user_paused: bool,
+    /// The drape under way: its cause, when it started (wall), and when it was sewn and
+    /// settled (simulated s, wall s since the start).
+    drape: (DrapeClock, Instant),
     settle: SettleWatch,
     error: Option<String>,
+    /// The error came from a step that diverged.
+    diverged: bool,
     drag: Option<Drag>,
     serial: u64,
     commands_done: u64,
@@ -307,8 +396,6 @@ impl WorkerState {
         let settle = SettleWatch::new(&scene);
         let mut state = Self {
             config: Arc::new(scene.config.clone()),
-            triangles: Arc::new(scene.model.triangles.clone()),
-            texture: Arc::new(scene.model.texture_space().0.to_vec()),
             props: Arc::default(),
             ground_z: None,
             scene,
@@ -318,8 +405,11 @@ impl WorkerState {
             playing: false,
             finished: false,
             paused_settled: false,
+            user_paused: false,
+            drape: (DrapeClock::default(), Instant::now()),
             settle,
             error: None,
+            diverged: false,
             drag: None,
             serial: 0,
             commands_done: 0,
@@ -374,7 +464,9 @@ impl WorkerState {
             }
             if self.playing && self.seconds_ahead() <= 0.0 {
                 self.step_once();
-                let end = self.scene.state.time >= self.scene.config.scene.duration - 1e-6 * self.scene.integrator.dt;
+                // A drape that went on from a sewn garment has the scene's duration from
+                // where it started.
+                let end = self.scene.state.time - self.drape.0.started_at >= self.scene.config.scene.duration - 1e-6 * self.scene.integrator.dt;
                 // A settled cloth pauses, as `rosette run` stops: it would only rest at the
                 // cost of a solve per step. Not while the mouse holds it, and only once:
                 // Play after the pause runs on to the scene's end.
@@ -392,6 +484,8 @@ impl WorkerState {
                 if settled && !self.paused_settled {
                     self.paused_settled = true;
                     self.playing = false;
+                    let wall = self.drape.1.elapsed().as_secs_f64();
+                    self.drape.0.settled.get_or_insert((self.scene.state.time, wall));
                 }
             }
             if self.dirty && (!self.playing || self.last_publish.elapsed() >= PUBLISH_INTERVAL) {
@@ -415,36 +509,41 @@ impl WorkerState {
     fn handle(&mut self, command: Command) {
         self.commands_done += 1;
         self.dirty = true;
+        self.diverged = false;
         match command {
             Command::LoadScene { name, config } => {
                 self.load(*config, Some(name), false).unwrap_or_else(|e| self.error = Some(e));
             }
             Command::Play => {
                 self.playing = true;
+                self.user_paused = false;
                 self.pace = (Instant::now(), self.scene.state.time);
             }
-            Command::Pause => self.playing = false,
+            Command::Pause => {
+                self.playing = false;
+                self.user_paused = true;
+            }
             Command::Step => {
                 self.playing = false;
+                self.user_paused = true;
                 self.step_once();
             }
             Command::Reset => {
                 let config = self.scene.config.clone();
                 let playing = self.playing;
                 self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(e));
+                self.drape.0.cause = DrapeCause::Reset;
             }
             Command::SetFabric(fabric) => {
                 let mut config = self.scene.config.clone();
                 config.fabric = *fabric;
-                let playing = self.playing;
-                self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(format!("fabric not applied: {e}")));
+                self.redrape(config, DrapeCause::Fabric).unwrap_or_else(|e| self.error = Some(format!("fabric not applied: {e}")));
             }
             Command::SetSolver { dt, integrator } => self.set_solver(dt, integrator),
             Command::SetPath(path) => {
                 let mut config = self.scene.config.clone();
                 config.solver.path = path;
-                let playing = self.playing;
-                self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(format!("solver path not applied: {e}")));
+                self.redrape(config, DrapeCause::Path).unwrap_or_else(|e| self.error = Some(format!("solver path not applied: {e}")));
             }
             Command::SetGrains(grains) => {
                 let mut config = self.scene.config.clone();
@@ -453,10 +552,9 @@ impl WorkerState {
                         panel.grain_deg = grain;
                     }
                 }
-                let playing = self.playing;
-                self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(format!("grains not applied: {e}")));
+                self.redrape(config, DrapeCause::Grain).unwrap_or_else(|e| self.error = Some(format!("grains not applied: {e}")));
             }
-            Command::DragVertex { vertex, target } => self.drag(vertex, target),
+            Command::DragVertex { vertex, mesh, target } => self.drag(vertex, mesh, target),
             Command::ReleaseDrag => self.release_drag(),
             Command::RunTest(name) => match load_scene(&name, &[]) {
                 Ok((mut config, _)) => {
@@ -482,11 +580,24 @@ impl WorkerState {
         Ok(())
     }
 
+    /// Rebuilds the scene for an edit (a fabric, grains, the path) and drapes it again: a
+    /// sewn garment whose pattern the edit keeps goes on from where it hangs, anything else
+    /// starts from t = 0. The drape plays unless the user had paused.
+    fn redrape(&mut self, config: SceneConfig, cause: DrapeCause) -> Result<(), String> {
+        let mut scene = Scene::build(config).map_err(|e| e.to_string())?;
+        let from_sewn = scene.continue_sewn(&self.scene);
+        let started_at = scene.state.time;
+        self.scene = scene;
+        self.install_scene_data();
+        self.drape.0 = DrapeClock { cause, started_at, from_sewn, ..DrapeClock::default() };
+        self.playing = !self.user_paused;
+        self.pace = (Instant::now(), started_at);
+        Ok(())
+    }
+
     /// Refreshes what snapshots share with the new scene and clears per-scene state.
     fn install_scene_data(&mut self) {
         self.config = Arc::new(self.scene.config.clone());
-        self.triangles = Arc::new(self.scene.model.triangles.clone());
-        self.texture = Arc::new(self.scene.model.texture_space().0.to_vec());
         let (grounds, solids): (Vec<_>, Vec<_>) =
             self.scene.props.iter().partition(|p| matches!(p.shape, crate::sim::contact::PropShape::Ground));
         self.ground_z = grounds.iter().map(|p| p.position.z).reduce(f64::max);
@@ -494,6 +605,7 @@ impl WorkerState {
         self.generation += 1;
         self.finished = false;
         self.paused_settled = false;
+        self.drape = (DrapeClock { started_at: self.scene.state.time, ..DrapeClock::default() }, Instant::now());
         self.settle = SettleWatch::new(&self.scene);
         self.error = None;
         self.drag = None;
@@ -513,12 +625,18 @@ impl WorkerState {
         self.error = None;
     }
 
-    fn drag(&mut self, vertex: u32, target: DVec3) {
-        let v = vertex as usize;
-        if v >= self.scene.model.vertex_count() || !target.is_finite() {
-            self.error = Some(format!("cannot drag vertex {vertex}: no such vertex or a non-finite target"));
+    fn drag(&mut self, vertex: u32, mesh: u64, target: DVec3) {
+        let topology = self.scene.topology();
+        if !topology.follows(mesh) {
+            // Picked on a mesh the cloth no longer has: the mouse lets go.
+            self.release_drag();
             return;
         }
+        let Some(vertex) = topology.carry_vertex(mesh, vertex).filter(|_| target.is_finite()) else {
+            self.error = Some(format!("cannot drag vertex {vertex}: no such vertex or a non-finite target"));
+            return;
+        };
+        let v = vertex as usize;
         if self.drag.as_ref().is_some_and(|d| d.vertex == vertex) {
             self.drag.as_mut().expect("checked").target = target;
             return;
@@ -531,6 +649,28 @@ impl WorkerState {
         let held_at = self.scene.state.x[v];
         self.scene.model.pin(vertex, held_at);
         self.drag = Some(Drag { vertex, target, held_at });
+        // A cloth that paused where it settled (or ended) moves again under the mouse, and
+        // settles again once let go; one the user paused stays paused.
+        if !self.playing && !self.user_paused {
+            self.playing = true;
+            self.paused_settled = false;
+            self.settle = SettleWatch::new(&self.scene);
+            self.pace = (Instant::now(), self.scene.state.time);
+        }
+    }
+
+    /// The mesh changed under a drag (`from` is the old mesh's version): a weld carries the
+    /// held vertex to its merged vertex, which the mouse goes on holding; a finer level or
+    /// a rebuilt mesh lets it go.
+    fn carry_drag(&mut self, from: u64) {
+        let Some(drag) = self.drag.take() else { return };
+        match self.scene.topology().carry_vertex(from, drag.vertex) {
+            Some(vertex) if !self.scene.model.fixed[vertex as usize] => {
+                self.scene.model.pin(vertex, drag.held_at);
+                self.drag = Some(Drag { vertex, ..drag });
+            }
+            _ => {}
+        }
     }
 
     fn release_drag(&mut self) {
@@ -539,11 +679,11 @@ impl WorkerState {
         }
     }
 
-    /// Moves the held point of a drag towards its target, at most DRAG_SPEED·dt and half an
-    /// edge per step.
+    /// Moves the held point of a drag towards its target, at most DRAG_SPEED·dt and
+    /// DRAG_STEP_EDGES of an edge per step.
     fn advance_drag(&mut self) {
         let Some(drag) = &mut self.drag else { return };
-        let limit = (DRAG_SPEED * self.scene.integrator.dt).min(0.5 * self.scene.model.mean_edge_length);
+        let limit = (DRAG_SPEED * self.scene.integrator.dt).min(DRAG_STEP_EDGES * self.scene.model.mean_edge_length);
         let to_target = drag.target - drag.held_at;
         let length = to_target.length();
         drag.held_at += if length > limit { to_target * (limit / length) } else { to_target };
@@ -552,6 +692,7 @@ impl WorkerState {
 
     fn step_once(&mut self) {
         self.advance_drag();
+        let mesh_before = self.scene.topology().version;
         let start = Instant::now();
         let result = self.scene.step();
         self.dirty = true;
@@ -562,12 +703,15 @@ impl WorkerState {
                     self.unconverged = (self.unconverged.0 + 1, self.unconverged.1.max(report.newton_residual));
                 }
                 self.error = None;
-                if self.scene.model.triangle_count() != self.triangles.len() {
-                    // The fast path moved to a finer level: a new mesh, whose vertices the
-                    // mouse no longer holds.
-                    self.triangles = Arc::new(self.scene.model.triangles.clone());
-                    self.texture = Arc::new(self.scene.model.texture_space().0.to_vec());
-                    self.drag = None;
+                if self.scene.topology().version != mesh_before {
+                    self.carry_drag(mesh_before);
+                }
+                let clock = &mut self.drape.0;
+                if clock.settled.is_none() {
+                    clock.stepping += start.elapsed().as_secs_f64();
+                }
+                if clock.sewn.is_none() && !clock.from_sewn && self.scene.garment.as_ref().is_some_and(|g| g.is_sewn()) {
+                    clock.sewn = Some((self.scene.state.time, self.drape.1.elapsed().as_secs_f64()));
                 }
                 let end = Instant::now();
                 self.timings.push_back(StepTiming { start, end, simulated: report.dt });
@@ -578,6 +722,7 @@ impl WorkerState {
             Err(e) => {
                 // The integrator left the state as it was: keep it and stop.
                 self.error = Some(e.to_string());
+                self.diverged = true;
                 self.playing = false;
             }
         }
@@ -619,6 +764,18 @@ impl WorkerState {
         stats
     }
 
+    /// The drape's clock now: from the weld (or from the start, for a drape that sews
+    /// nothing) until it settled or until now.
+    fn drape_clock(&self) -> DrapeClock {
+        let (clock, started) = self.drape;
+        let wall = started.elapsed().as_secs_f64();
+        let needs_sewing = self.scene.garment.is_some() && !clock.from_sewn;
+        let from = if needs_sewing { clock.sewn } else { Some((clock.started_at, 0.0)) };
+        let until = clock.settled.unwrap_or((self.scene.state.time, wall));
+        let since_weld = from.map_or((0.0, 0.0), |(t, w)| ((until.0 - t).max(0.0), (until.1 - w).max(0.0)));
+        DrapeClock { wall, since_weld, ..clock }
+    }
+
     fn publish(&mut self) {
         self.serial += 1;
         let model = &self.scene.model;
@@ -631,9 +788,7 @@ impl WorkerState {
             scene_name: self.scene_name.clone(),
             config: Arc::clone(&self.config),
             positions: x.clone(),
-            triangles: Arc::clone(&self.triangles),
-            texture: Arc::clone(&self.texture),
-            warp_angle: model.texture_space().1,
+            topology: Arc::clone(self.scene.topology()),
             fixed: model.fixed.clone(),
             props: Arc::clone(&self.props),
             ground_z: self.ground_z,
@@ -648,7 +803,10 @@ impl WorkerState {
             stats: self.stats(),
             measures: Arc::new(self.scene.measures()),
             error: self.error.clone(),
+            diverged: self.diverged && self.error.is_some(),
             dragged: self.drag.as_ref().map(|d| d.vertex),
+            sewing: self.scene.sewing_progress(),
+            drape: self.drape_clock(),
             coarse_level: !self.scene.at_final_level(),
         };
         *self.mailbox.slot.lock().expect("mailbox lock") = Some(Arc::new(snapshot));

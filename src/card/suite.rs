@@ -64,17 +64,17 @@ enum Outcome {
     Shear(ShearTest),
 }
 
-/// `fabric` as the bundled scene `scene` runs it: the scene's own `[fabric]` keys other than
-/// the fabric's name laid over it (the drape scenes turn the Poisson coupling off,
-/// docs/drape.md), as `rosette run SCENE --set fabric.preset=FABRIC` lays them over a fabric
-/// file. A scene that is not bundled leaves the fabric as it is.
-pub fn scene_fabric(scene: &str, fabric: &FabricConfig) -> Result<FabricConfig, CardError> {
+/// `fabric` as the scene `config` runs it: the scene's own `[fabric]` keys other than the
+/// fabric's name (and any `--set fabric.KEY`) laid over it (the drape scenes and the
+/// garments turn the Poisson coupling off, docs/drape.md), as `rosette run SCENE --set
+/// fabric.preset=FABRIC` lays them over a fabric file.
+pub fn scene_fabric(config: &SceneConfig, fabric: &FabricConfig) -> Result<FabricConfig, CardError> {
     let bad = |m: String| CardError::BadInput(m);
-    let Some(bundled) = SCENES.iter().find(|s| s.name == scene) else { return Ok(fabric.clone()) };
-    let text: toml::Table = bundled.text.parse().map_err(|e| bad(format!("{scene}: {e}")))?;
-    let Some(keys) = text.get("fabric").and_then(|v| v.as_table()) else { return Ok(fabric.clone()) };
+    if config.own_fabric_keys.is_empty() {
+        return Ok(fabric.clone());
+    }
     let mut table = toml::Table::try_from(fabric).map_err(|e| bad(format!("fabric: {e}")))?;
-    for (key, value) in keys.iter().filter(|(k, _)| !matches!(k.as_str(), "preset" | "name" | "description")) {
+    for (key, value) in config.own_fabric_keys.iter().filter(|(k, _)| !matches!(k.as_str(), "preset" | "name" | "description")) {
         table.insert(key.clone(), value.clone());
     }
     toml::Value::Table(table).try_into().map_err(|e: toml::de::Error| bad(format!("fabric: {}", e.message())))
@@ -86,7 +86,7 @@ pub fn drape_config(scene: &str, fabric: &FabricConfig) -> Result<SceneConfig, C
         return Err(CardError::BadInput(format!("no bundled scene named '{scene}'")));
     }
     let (mut config, _) = load_scene(scene, &[]).map_err(|e| CardError::BadInput(e.to_string()))?;
-    config.fabric = scene_fabric(scene, fabric)?;
+    config.fabric = scene_fabric(&config, fabric)?;
     config.material().map_err(|e| CardError::BadInput(format!("{scene} with this fabric: {e}")))?;
     Ok(config)
 }

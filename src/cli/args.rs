@@ -169,8 +169,24 @@ pub enum Command {
         overrides: Vec<String>,
         /// Take the fast path (solver.path = "fast"): settling scenes settle coarse to fine,
         /// with longer steps and Newton solved to the step's own accuracy (docs/solvers.md).
-        #[arg(long)]
+        /// Garments open on it unless the path is set.
+        #[arg(long, conflicts_with = "exact")]
         fast: bool,
+        /// Take the exact path (solver.path = "exact"), the validated reference, also for
+        /// a garment.
+        #[arg(long)]
+        exact: bool,
+        /// Play a scripted session: a timeline of what a person does in the window (wait,
+        /// switch fabric or path, recut, pin, drag, orbit, screenshot, quit; docs/viewer.md).
+        #[arg(long, value_name = "FILE.toml")]
+        script: Option<std::path::PathBuf>,
+        /// Write the session's report (what each step saw) as JSON when it ends.
+        #[arg(long, value_name = "FILE.json", requires = "script")]
+        report: Option<std::path::PathBuf>,
+        /// Replace existing files the session writes that are not Rosette's own output of the
+        /// same kind (an input is never overwritten).
+        #[arg(long)]
+        force: bool,
     },
 }
 

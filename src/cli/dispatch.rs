@@ -29,12 +29,16 @@ pub fn dispatch(cli: Cli) -> ExitCode {
             }
             code
         }
-        None => view(ViewerOptions { preset: None, quit_after_frames: cli.quit_after_frames, overrides: Vec::new() }),
-        Some(Command::View { preset, quit_after_frames, mut overrides, fast }) => {
+        None => super::view::view(ViewerOptions { quit_after_frames: cli.quit_after_frames, ..ViewerOptions::default() }, None, false),
+        Some(Command::View { preset, quit_after_frames, mut overrides, fast, exact, script, report, force }) => {
             if fast {
                 overrides.push(SolverPath::Fast.setting());
             }
-            view(ViewerOptions { preset, quit_after_frames, overrides })
+            if exact {
+                overrides.push(SolverPath::Exact.setting());
+            }
+            let options = ViewerOptions { preset, quit_after_frames, overrides, report, ..ViewerOptions::default() };
+            super::view::view(options, script.as_deref(), force)
         }
         Some(Command::Presets) => {
             for (name, description) in preset::scene_descriptions() {
@@ -76,12 +80,3 @@ pub fn dispatch(cli: Cli) -> ExitCode {
     }
 }
 
-fn view(options: ViewerOptions) -> ExitCode {
-    match rosette::app::viewer::run(options) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            errln!("error: {e:#}");
-            ExitCode::from(super::EXIT_BAD_INPUT)
-        }
-    }
-}

@@ -11,6 +11,7 @@ pub mod outputs;
 pub mod pattern;
 pub mod run;
 pub mod sweeps;
+pub mod view;
 
 use rosette::errln;
 use std::io::IsTerminal;

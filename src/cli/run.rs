@@ -13,6 +13,7 @@ use rosette::scene::{RunOptions, Scene, SceneConfig, StepRecord, possible, run_s
 use rosette::{errln, outln, render};
 use std::io::{IsTerminal, Write};
 use std::path::Path;
+use std::sync::Arc;
 use std::process::ExitCode;
 
 /// Where `rosette run` writes what it measured (nothing by default).
@@ -170,12 +171,12 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
     };
     let mut recorder = outputs.export_frames.map(|n| {
         let mut r = rosette::export::Recorder::new(n, scene.state.time, limits.duration.unwrap_or(scene.config.scene.duration));
-        r.observe(scene.state.time, &scene.state.x);
+        r.observe(scene.state.time, scene.topology(), &scene.state.x);
         r
     });
     let mut on_state = |s: &Scene| {
         if let Some(r) = recorder.as_mut() {
-            r.observe(s.state.time, &s.state.x);
+            r.observe(s.state.time, s.topology(), &s.state.x);
         }
     };
     let options = RunOptions {
@@ -230,12 +231,10 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
     if let Some(path) = outputs.export {
         // The last good state (and the run up to it), also after a divergence.
         let frames = match recorder {
-            Some(r) => r.finish(scene.state.time, &scene.state.x),
-            None => vec![(scene.state.time, scene.state.x.clone())],
+            Some(r) => r.finish(scene.state.time, scene.topology(), &scene.state.x),
+            None => vec![rosette::export::ClothFrame { time: scene.state.time, topology: Arc::clone(scene.topology()), positions: scene.state.x.clone() }],
         };
-        let (rest, warp_angle) = scene.model.texture_space();
-        let cloth = rosette::export::Cloth { triangles: &scene.model.triangles, rest, warp_angle, name: &name };
-        match rosette::export::write_glb(path, &cloth, &frames) {
+        match rosette::export::write_glb(path, &name, &frames) {
             Ok(()) => errln!("wrote {} ({} frame{})", path.display(), frames.len(), if frames.len() == 1 { "" } else { "s" }),
             Err(e) => fail(format!("--export: {e}")),
         }

@@ -26,6 +26,8 @@ pub enum FileKind {
     Arcsim,
     /// A sewing pattern in GarmentCode's specification format (JSON).
     Pattern,
+    /// A scripted session for the viewer (TOML).
+    Script,
 }
 
 impl FileKind {
@@ -34,7 +36,7 @@ impl FileKind {
     /// of the largest prop contact resolves well (a million triangles) is about 60 MB.
     pub fn limit(self) -> u64 {
         match self {
-            FileKind::Scene | FileKind::Fabric => 1 << 20,
+            FileKind::Scene | FileKind::Fabric | FileKind::Script => 1 << 20,
             FileKind::Obj => 128 << 20,
             FileKind::Csv => 16 << 20,
             // A material is under 2 kB; its comments may be long.
@@ -53,6 +55,7 @@ impl FileKind {
             FileKind::Csv => "CSV file",
             FileKind::Arcsim => "material file in ARCSim's JSON format",
             FileKind::Pattern => "pattern in GarmentCode's JSON format",
+            FileKind::Script => "viewer script",
         }
     }
 
@@ -60,7 +63,7 @@ impl FileKind {
     /// contents are not quoted in messages (see [`quotable`]).
     pub fn extension(self) -> &'static str {
         match self {
-            FileKind::Scene | FileKind::Fabric => "toml",
+            FileKind::Scene | FileKind::Fabric | FileKind::Script => "toml",
             FileKind::Obj => "obj",
             FileKind::Csv => "csv",
             FileKind::Arcsim | FileKind::Pattern => "json",

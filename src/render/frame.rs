@@ -73,6 +73,13 @@ impl Frame {
         frame
     }
 
+    /// Whether the cloth's triangles and texture coordinates are those of its positions:
+    /// every index names a position, one texture coordinate per position.
+    pub fn cloth_is_whole(&self) -> bool {
+        let n = self.cloth_positions.len();
+        self.cloth_uv.len() == n && self.cloth_triangles.iter().flatten().all(|&v| (v as usize) < n)
+    }
+
     /// Axis-aligned bounds of the cloth and the props, or `None` for an empty frame.
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
         bounds_of(self.cloth_positions.iter().chain(self.props.iter().flat_map(|p| p.positions.iter())))

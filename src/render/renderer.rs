@@ -549,6 +549,11 @@ pub(crate) fn linear_to_srgb(c: f32) -> f32 {
 /// The cloth de-indexed, with smooth (area-weighted) vertex normals and the colour-scale
 /// position of each vertex.
 fn cloth_vertices(frame: &Frame) -> Vec<Vertex> {
+    if !frame.cloth_is_whole() {
+        // Positions and triangles of two different meshes: drawing them would index past
+        // the positions or draw a torn cloth, so the cloth is left out of this frame.
+        return Vec::new();
+    }
     let positions: Vec<Vec3> = frame.cloth_positions.iter().map(|p| Vec3::from_array(*p)).collect();
     let mut normals = vec![Vec3::ZERO; positions.len()];
     for tri in &frame.cloth_triangles {

@@ -78,6 +78,7 @@ impl Scene {
         next.state.steps = self.state.steps;
         next.integrator.contact_stats = self.integrator.contact_stats;
         self.model = next.model;
+        self.topology = next.topology;
         self.state = next.state;
         self.integrator = next.integrator;
         self.sample_every = next.sample_every;

@@ -4,7 +4,7 @@
 //! field rather than the fabric key it became, `--duration` rather than `scene.duration`.
 
 use crate::settings::read::{PresetKind, apply_override, looks_like_path, parse_override, read_preset};
-use crate::settings::{FabricConfig, PresetError, SceneConfig};
+use crate::settings::{FabricConfig, Origin, Origins, PresetError, SceneConfig};
 use crate::fabric::Import;
 use crate::io::number::short;
 use std::path::Path;
@@ -165,6 +165,11 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
         import: Import::default(),
         original: toml::Table::new(),
     };
+    // A bundled scene, or the scene a pattern import writes, is the project's; any other
+    // file is the user's. Each `--set` and flag is the user's.
+    let scene_origin = if file.ends_with("(bundled)") || crate::settings::read::is_pattern_spec(spec) { Origin::Bundled } else { Origin::User };
+    let mut origins = Origins::default();
+    origins.record_table("", &table, scene_origin);
     let mut fabric_table = None;
     // The fabric file named in the scene file, for the original values.
     if let Some(name) = table.get("fabric").and_then(|f| f.get("preset")).and_then(|v| v.as_str()) {
@@ -175,17 +180,20 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
     for o in overrides {
         let (path, value) = parse_override(o)?;
         apply_override(&mut table, &path, value).map_err(|m| PresetError::BadOverride { text: o.clone(), message: m })?;
+        origins.record(&path.join("."), Origin::User);
         sources.overrides.push((path, format!("--set {o}")));
     }
     if let Some(n) = flags.max_steps {
         let path = key_parts("scene.max_steps");
         apply_override(&mut table, &path, toml::Value::Integer(i64::try_from(n).unwrap_or(i64::MAX))).expect("[scene] is a table");
+        origins.record("scene.max_steps", Origin::User);
         sources.overrides.push((path, format!("--max-steps {n}")));
         sources.flags.push(("scene.max_steps", "--max-steps"));
     }
     if flags.duration.is_some() {
         sources.flags.push(("--duration = ", "--duration "));
     }
+    let own_fabric_keys = table.get("fabric").and_then(|v| v.as_table()).cloned().unwrap_or_default();
     let preset = table.get("fabric").and_then(|f| f.get("preset"));
     if let Some(preset) = preset {
         let name = preset.as_str().ok_or_else(|| sources.invalid(&key_parts("fabric.preset"), format!("fabric.preset must be a fabric name or file in quotes, got {preset}")))?;
@@ -230,6 +238,8 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
         sources.invalid(&parts, type_error(&key, &message, example))
     })?;
     config.base_dir = base;
+    config.origins = origins;
+    config.own_fabric_keys = own_fabric_keys;
     crate::settings::validate::check_scene_for(&config, flags.duration).map_err(|e| match (e.key.as_str(), flags.duration) {
         ("--duration", Some(d)) => PresetError::Invalid { file: format!("--duration {}", short(d)), message: sources.in_flags(e.message) },
         (key, _) if key.starts_with("fabric.") => sources.fabric_invalid(key, e.message),

@@ -14,8 +14,10 @@ pub mod run;
 pub mod strip;
 pub mod plan;
 pub mod swing;
+pub mod topology;
 
 pub use measures::Measures;
+pub use topology::Topology;
 pub use crate::settings::{SceneConfig, SceneKind};
 pub use load::{RunFlags, load_scene, load_scene_with};
 pub use run::{ContactEvents, Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
@@ -57,6 +59,8 @@ pub struct Scene {
     /// Wall-clock time past which no step starts another Newton iteration
     /// (`Integrator::deadline`, set from `--max-wall`); None: no bound.
     pub deadline: Option<std::time::Instant>,
+    /// The mesh the model has now; replaced with the model (`Scene::topology`).
+    topology: std::sync::Arc<Topology>,
 }
 
 
@@ -99,7 +103,8 @@ impl Scene {
             let rig = Rig::Garment(Box::new(parts.rig));
             let (state, model, props) = (State::at_rest(parts.x), parts.model, parts.props);
             let sample_every = (steps / 400).max(1);
-            return Ok(Self { state, config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: Some(parts.sewing), deadline: None });
+            let topology = std::sync::Arc::new(Topology::of(&model));
+            return Ok(Self { state, config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: Some(parts.sewing), deadline: None, topology });
         }
         let c = &level_config.cloth;
         let warp = c.warp_angle_deg.to_radians();
@@ -136,7 +141,8 @@ impl Scene {
         let integrator = level_config.solver.integrator();
         let steps = (config.scene.duration / level_config.solver.dt).ceil().max(1.0) as u64;
         let sample_every = (steps / 400).max(1);
-        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: None, deadline: None })
+        let topology = std::sync::Arc::new(Topology::of(&model));
+        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: None, deadline: None, topology })
     }
 
     /// Changes the time step (s) and integrator, keeping positions, velocities, time and
@@ -154,6 +160,12 @@ impl Scene {
         self.integrator = integrator;
         self.state.clear_history();
         Ok(())
+    }
+
+    /// The cloth's mesh now, with a version that changes whenever the mesh does (a weld, a
+    /// finer level): what snapshots and exports carry beside the positions.
+    pub fn topology(&self) -> &std::sync::Arc<Topology> {
+        &self.topology
     }
 
     /// Whether the scene is on its own mesh: always on the exact path, and on the fast path

@@ -22,6 +22,18 @@ use crate::physics::{bending_length, weight_per_area};
 use crate::sim::PreconditionerChoice;
 use std::fmt::Write as _;
 
+/// The path a scene opens on in the viewer: the user's where they set one (`--fast`,
+/// `--exact`, `--set solver.path`, their own scene file); else the fast path for a garment,
+/// whose error against the exact path is within the scatter of its folds (docs/fast-path.md)
+/// and which a designer would otherwise wait several times as long for; else the scene's.
+pub fn opening_path(config: &SceneConfig) -> SolverPath {
+    if config.origins.by_user("solver.path") || config.scene.kind != SceneKind::Garment {
+        config.solver.path
+    } else {
+        SolverPath::Fast
+    }
+}
+
 /// Which step design a scene runs on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Design {

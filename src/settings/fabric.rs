@@ -7,7 +7,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// A fabric as a file gives it: the simulator's properties (SI units per unit width, the
 /// curves as points) with its name, and in a scene the fabric file it starts from.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FabricConfig {
     /// Bundled fabric name or path of the fabric file this one starts from.
     pub preset: Option<String>,

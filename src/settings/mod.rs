@@ -12,12 +12,14 @@
 //! layer, since the fabric's measurement sheets are converted on the way.
 
 pub mod fabric;
+pub mod origin;
 pub mod read;
 pub mod registry;
 pub mod schema;
 pub mod validate;
 
 pub use fabric::FabricConfig;
+pub use origin::{Origin, Origins};
 pub use read::{PresetError, PresetKind, parse_override, read_preset, scene_descriptions};
 pub use registry::{ASSETS, Asset, Bundled, FABRICS, SCENES};
 pub use schema::{

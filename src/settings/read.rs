@@ -31,6 +31,12 @@ pub fn is_arcsim_file(spec: &str) -> bool {
     Path::new(spec).extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
 }
 
+/// Whether the scene `spec` names a sewing pattern (GarmentCode's `….json`), which stands
+/// for the scene `rosette pattern import` writes for it.
+pub fn is_pattern_spec(spec: &str) -> bool {
+    is_arcsim_file(spec)
+}
+
 /// What a name or a path stands for: a scene or a fabric.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PresetKind {

@@ -32,6 +32,22 @@ pub enum SceneKind {
     Swing,
 }
 
+impl SceneKind {
+    /// The kind as a scene file names it (`scene.kind`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Tensile => "tensile",
+            Self::Cantilever => "cantilever",
+            Self::Arc => "arc",
+            Self::EulerBuckling => "euler-buckling",
+            Self::ShearBuckling => "shear-buckling",
+            Self::Drape => "drape",
+            Self::Garment => "garment",
+            Self::Swing => "swing",
+        }
+    }
+}
+
 /// A complete scene description, after the fabric file and overrides are merged.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -59,6 +75,13 @@ pub struct SceneConfig {
     /// Directory of the scene file, for relative asset paths (none for bundled scenes).
     #[serde(skip)]
     pub base_dir: Option<PathBuf>,
+    /// Where each value came from (`scene::load`): the plan keeps what the user set.
+    #[serde(skip)]
+    pub origins: super::Origins,
+    /// The scene's own `[fabric]` keys (and `--set fabric.KEY`), laid over the fabric file:
+    /// what stays when another fabric is chosen for the scene (`card::scene_fabric`).
+    #[serde(skip)]
+    pub own_fabric_keys: toml::Table,
 }
 
 /// The kinds of prop a scene can place.

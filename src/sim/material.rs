@@ -13,7 +13,7 @@ use thiserror::Error;
 /// Measured properties of a fabric, in SI units per unit width: the simulator's material,
 /// and (with its curves as lists of points, [`FabricPoints`]) what a fabric file holds. One
 /// definition serves both, so that a property is added in one place.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Fabric<Curve = PiecewiseLinear> {
     /// Mass per unit area, kg/m².

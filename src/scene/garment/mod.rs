@@ -37,7 +37,10 @@ pub struct Sewing {
     damping: (f64, f64),
     /// The welded cloth's model, built with the scene; taken at the weld.
     welded: Option<Model>,
-    /// Vertices pinned once the garment is sewn (attached ones), unsewn numbering.
+    /// Vertices the pattern pins from the start (`garment.pinned`) and those pinned once
+    /// the garment is sewn (attached ones), unsewn numbering: what the weld pins, and not a
+    /// vertex the viewer's mouse happens to hold then.
+    pinned: Vec<u32>,
     pin_after: Vec<u32>,
     /// Each seam's vertex pairs (unsewn numbering), and whether it has been open (a pair
     /// farther apart than `closed_gap`) from the start until the last step.
@@ -58,6 +61,17 @@ impl Sewing {
     pub fn failed(&self, time: f64) -> bool {
         !self.is_sewn() && time > self.deadline
     }
+}
+
+/// How a garment's sewing stands (`Scene::sewing_progress`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SewingProgress {
+    /// When the seams were welded, s.
+    pub sewn_at: Option<f64>,
+    /// The largest gap still open between a seam's pairs, m (0 once sewn).
+    pub open_gap: f64,
+    /// The sewing time passed with a seam still open.
+    pub failed: bool,
 }
 
 /// The parts `Scene::build_level` assembles for a garment.
@@ -133,6 +147,7 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
         closed_gap,
         damping: (g.sewing_damping, config.solver.damping),
         welded: Some(welded),
+        pinned: garment.pinned.clone(),
         pin_after,
         seams: garment.seams.clone(),
         open,
@@ -355,6 +370,63 @@ impl Scene {
         self.model.options.damping = sewing.damping.0;
     }
 
+    /// How the garment's sewing stands, for the viewer: when it was welded, or the largest
+    /// gap still open between the seams' pairs (m) and whether its sewing time has passed.
+    pub fn sewing_progress(&self) -> Option<SewingProgress> {
+        let sewing = self.garment.as_ref()?;
+        Some(SewingProgress {
+            sewn_at: sewing.sewn_at,
+            open_gap: if sewing.is_sewn() { 0.0 } else { self.model.sewing.largest_gap(&self.state.x) },
+            failed: sewing.failed(self.state.time),
+        })
+    }
+
+    /// Takes `earlier`'s sewn garment into this garment scene, just built and not yet
+    /// stepped, where both cut the very same mesh (another fabric, other grains, the other
+    /// solver path): the garment re-drapes from where it hangs instead of being sewn again
+    /// from flat panels. This scene's welded cloth (its own fabric and grains) takes the
+    /// earlier cloth's positions, velocities and clock, and the pins the weld sets. Returns
+    /// whether it did; where the pattern changed, the new scene sews from the start.
+    pub fn continue_sewn(&mut self, earlier: &Scene) -> bool {
+        let (Some(sewing), Some(before)) = (&mut self.garment, &earlier.garment) else { return false };
+        let same_mesh = sewing.welded.as_ref().is_some_and(|w| w.triangles == earlier.model.triangles && w.rest == earlier.model.rest);
+        if !before.is_sewn() || sewing.is_sewn() || self.state.steps > 0 || !same_mesh {
+            return false;
+        }
+        let mut model = sewing.welded.take().expect("checked above");
+        let weld_map = &self.model.sewing.welded;
+        for &v in sewing.pinned.iter().chain(&sewing.pin_after) {
+            let w = weld_map[v as usize];
+            model.pin(w, earlier.state.x[w as usize]);
+        }
+        model.options = self.model.options;
+        model.options.damping = sewing.damping.1;
+        let mut state = State::at_rest(earlier.state.x.clone());
+        state.v = earlier.state.v.clone();
+        state.time = earlier.state.time;
+        state.steps = earlier.state.steps;
+        (sewing.sewn_at, sewing.gap_at_weld) = (before.sewn_at, before.gap_at_weld);
+        if let (super::rigs::Rig::Garment(rig), Some(at), Some(gap)) = (&mut self.rig, before.sewn_at, before.gap_at_weld) {
+            rig.welded(weld_map, at, gap);
+        }
+        // The same mesh keeps its version (buffers and drags stay valid) unless its texture
+        // turned with new grains; then a merge onto itself keeps the vertices' indices.
+        self.topology = if model.texture_space().0 == earlier.topology.texture.as_slice() {
+            std::sync::Arc::clone(&earlier.topology)
+        } else {
+            let identity = (0..model.vertex_count() as u32).collect();
+            std::sync::Arc::new(super::Topology::merged(&model, &earlier.topology, identity))
+        };
+        self.integrator = {
+            let mut integrator = super::plan::level(&self.config, self.level_edge).solver.integrator();
+            integrator.contact_stats = earlier.integrator.contact_stats;
+            integrator
+        };
+        self.model = model;
+        self.state = state;
+        true
+    }
+
     /// After a step: welds the garment once every seam and attachment is closed.
     pub(super) fn sew_after_step(&mut self) {
         let Some(sewing) = &mut self.garment else { return };
@@ -383,7 +455,7 @@ impl Scene {
             position[w] /= mass[w];
             velocity[w] /= mass[w];
         }
-        for v in self.model.fixed.iter().enumerate().filter(|(_, f)| **f).map(|(v, _)| v as u32).chain(sewing.pin_after.iter().copied()) {
+        for &v in sewing.pinned.iter().chain(&sewing.pin_after) {
             let w = weld_map[v as usize];
             model.pin(w, position[w as usize]);
         }
@@ -400,6 +472,7 @@ impl Scene {
         if let super::rigs::Rig::Garment(rig) = &mut self.rig {
             rig.welded(weld_map, self.state.time, gap);
         }
+        self.topology = std::sync::Arc::new(super::Topology::merged(&model, &self.topology, weld_map.clone()));
         self.model = model;
         self.state = state;
         self.integrator = integrator;

@@ -235,7 +235,7 @@ impl Integrator {
         let (Some(before), Some(full), Some(cached)) = (history.previous_norm, history.previous_full_step, self.preconditioner.as_ref()) else {
             return None;
         };
-        if !(cached.size == y.len() && norm < 0.5 * before && full * norm / before < problem.tolerance) {
+        if !(cached.fits(&problem.step.model.fixed) && norm < 0.5 * before && full * norm / before < problem.tolerance) {
             return None;
         }
         cached.preconditioner.apply(&work.rhs, &mut work.direction);

@@ -18,8 +18,8 @@ impl Integrator {
     /// costs several CG iterations. It is rebuilt once the iterations it has cost beyond
     /// what it took when new add up to what building it cost (the rent-or-buy rule: never
     /// more than twice the best choice made in hindsight).
-    fn preconditioner_is_stale(&self, n: usize) -> bool {
-        self.preconditioner.as_ref().is_none_or(|p| p.size != n || p.excess >= p.preconditioner.cost_in_iterations())
+    fn preconditioner_is_stale(&self, fixed: &[bool]) -> bool {
+        self.preconditioner.as_ref().is_none_or(|p| !p.fits(fixed) || p.excess >= p.preconditioner.cost_in_iterations())
     }
 
     /// Solves Newton's system with a global preconditioner (the complete factor or the
@@ -49,7 +49,6 @@ impl Integrator {
     /// so the shifted exact matrix takes fewer Newton iterations (the fine drape's figures
     /// are in docs/performance-log.md).
     fn solve_shifted(&mut self, exact: &SystemMatrix, positions: &[DVec3], direction: &mut [DVec3], solve: &mut Solve) -> bool {
-        let n = exact.fixed.len();
         let mut rebuild = false;
         let mut raised = false;
         loop {
@@ -66,12 +65,12 @@ impl Integrator {
                 raised = true;
                 true
             };
-            if rebuild || self.preconditioner_is_stale(n) {
+            if rebuild || self.preconditioner_is_stale(exact.fixed) {
                 let factor = self.global_factor(&system, positions);
                 solve.report.factorizations += 1;
                 solve.watch.solve();
                 match factor {
-                    Some(factor) => self.preconditioner = Some(CachedPreconditioner { shift: self.shift, ..CachedPreconditioner::new(n, factor) }),
+                    Some(factor) => self.preconditioner = Some(CachedPreconditioner { shift: self.shift, ..CachedPreconditioner::new(exact.fixed, factor) }),
                     None if raise(&mut self.shift) => {
                         rebuild = true;
                         continue;
@@ -120,7 +119,6 @@ impl Integrator {
         report: &mut StepReport,
         watch: &mut Stopwatch,
     ) {
-        let n = y.len();
         let mut solve = Solve { rhs, cg_tolerance, report: &mut *report, watch: &mut *watch };
         if !*bounded_throughout && !self.solve_shifted(system, y, direction, &mut solve) {
             // This step's remaining iterations take the bounded matrix, positive definite,
@@ -132,10 +130,10 @@ impl Integrator {
             problem.assemble(y, bounded, CompressedEdges::Within(&problem.softening));
             watch.forces();
             let system = SystemMatrix { stiffness: bounded, ..*system };
-            if self.preconditioner_is_stale(n) {
+            if self.preconditioner_is_stale(system.fixed) {
                 let preconditioner = self.global_factor(&system, y).unwrap_or_else(|| system.preconditioner(FactorPattern::Wide));
                 report.factorizations += 1;
-                self.preconditioner = Some(CachedPreconditioner::new(n, preconditioner));
+                self.preconditioner = Some(CachedPreconditioner::new(system.fixed, preconditioner));
                 watch.solve();
             }
             let cached = self.preconditioner.as_mut().expect("built above");
@@ -170,7 +168,7 @@ impl Integrator {
     ) -> bool {
         let n = y.len();
         let mut bounded_ready = false;
-        if self.preconditioner_is_stale(n) {
+        if self.preconditioner_is_stale(system.fixed) {
             // Factors are made from the bounded matrix. Made from the exact one, the Euler
             // strip's buckling onset under BDF2 came late, beyond the onset test's
             // tolerance, where the bounded one's is within it: near the bifurcation the
@@ -196,7 +194,7 @@ impl Integrator {
                     report.factorizations += 1;
                 }
             }
-            self.preconditioner = Some(CachedPreconditioner::new(n, preconditioner));
+            self.preconditioner = Some(CachedPreconditioner::new(system.fixed, preconditioner));
             watch.solve();
         }
         let cached = self.preconditioner.as_mut().expect("built above");
@@ -270,8 +268,12 @@ struct Solve<'a> {
 
 /// A preconditioner with what it was built for and how quick it made CG when new.
 pub(super) struct CachedPreconditioner {
-    /// Vertices of the matrix it was built from.
-    pub size: usize,
+    /// The fixed vertices of the matrix it was built from (its size too): a vertex fixed
+    /// since (a pin, the viewer's mouse) or freed makes it another matrix. A factor whose
+    /// row for a newly fixed vertex is still free moves that vertex in CG's directions,
+    /// which Newton's system does not: a garment held by the mouse took 100 Newton
+    /// iterations a step without converging until its factor aged out.
+    fixed: Vec<bool>,
     pub preconditioner: Preconditioner,
     /// CG iterations per e-fold of residual reduction on its first solve.
     fresh_rate: Option<f64>,
@@ -285,8 +287,13 @@ pub(super) struct CachedPreconditioner {
 }
 
 impl CachedPreconditioner {
-    fn new(size: usize, preconditioner: Preconditioner) -> Self {
-        Self { size, preconditioner, fresh_rate: None, excess: 0.0, iterations: 0.0, efolds: 0.0, shift: 0.0 }
+    fn new(fixed: &[bool], preconditioner: Preconditioner) -> Self {
+        Self { fixed: fixed.to_vec(), preconditioner, fresh_rate: None, excess: 0.0, iterations: 0.0, efolds: 0.0, shift: 0.0 }
+    }
+
+    /// Whether it was built for a matrix with these vertices fixed.
+    pub fn fits(&self, fixed: &[bool]) -> bool {
+        self.fixed == fixed
     }
 
     /// Counts a solve's iterations beyond the rate this preconditioner had when new.
@@ -417,13 +424,13 @@ mod tests {
     fn a_solve_stopped_at_the_limit_renews_the_factor() {
         use crate::sim::linalg::{CgReport, Preconditioner};
         let solve = |iterations, relative_residual, reached| CgReport { iterations, relative_residual, negative_curvature: false, reached };
-        let mut cached = CachedPreconditioner::new(2, Preconditioner::BlockJacobi(vec![glam::DMat3::IDENTITY; 2]));
+        let mut cached = CachedPreconditioner::new(&[false; 2], Preconditioner::BlockJacobi(vec![glam::DMat3::IDENTITY; 2]));
         cached.record(&solve(40, 1e-3, true));
         cached.record(&solve(38, 1e-3, true));
         assert_eq!(cached.excess, 0.0, "solves at the factor's first rate add no excess");
         cached.record(&solve(60, 1e-3, true));
         assert!(cached.excess > 19.0 && cached.excess.is_finite(), "a slower solve adds its extra iterations: {}", cached.excess);
-        let mut stopped = CachedPreconditioner::new(2, Preconditioner::BlockJacobi(vec![glam::DMat3::IDENTITY; 2]));
+        let mut stopped = CachedPreconditioner::new(&[false; 2], Preconditioner::BlockJacobi(vec![glam::DMat3::IDENTITY; 2]));
         stopped.record(&solve(200, 0.6, false));
         assert!(stopped.excess.is_infinite(), "a first solve stopped at the limit: {}", stopped.excess);
         cached.record(&solve(200, 0.6, false));
