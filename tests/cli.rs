@@ -466,3 +466,30 @@ fn bench_quick_writes_one_row_per_case() {
         assert!(column(row, "period_error").abs() < 0.01, "the swing's period against the hanging chain's: {row:?}");
     }
 }
+
+/// The run plan never replaces a value of the user's in silence: `--plan` says which
+/// values it chose over the scene's and which of the user's it kept, and a run's metrics
+/// list both (`plan_overrides`); the user's value is the one the run takes.
+#[test]
+fn the_plan_says_what_it_chose_and_keeps_what_the_user_set() {
+    let plan = rosette(&["run", "tablecloth", "--fast", "--set", "solver.newton.max_iterations=2", "--plan"]);
+    assert!(plan.status.success(), "{}", text(&plan.stderr));
+    let described = text(&plan.stdout);
+    assert!(described.contains("at most 2 iterations"), "{described}");
+    assert!(described.contains("kept: solver.newton.max_iterations = 2 (yours; the plan would take 80"), "{described}");
+    assert!(described.contains("chosen: solver.dt = 0.016 (replaces the bundled scene's 0.004"), "{described}");
+    // A short run of the same: the metrics list the choices, and Newton stopped at 2.
+    let path = metrics_path("plan-overrides");
+    let run = rosette(&[
+        "run", "tablecloth", "--fast", "--set", "solver.newton.max_iterations=2", "--duration", "0.128", "--metrics", path.to_str().unwrap(),
+    ]);
+    assert!(matches!(run.status.code(), Some(0 | 5)), "{}", text(&run.stderr));
+    let metrics: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let overrides = metrics["plan_overrides"].as_array().expect("plan_overrides in the metrics");
+    let entry = |key: &str| overrides.iter().find(|o| o["key"] == key).unwrap_or_else(|| panic!("{key} missing: {overrides:?}"));
+    assert_eq!(entry("solver.newton.max_iterations")["kept"], true);
+    assert_eq!(entry("solver.newton.max_iterations")["value"], "2");
+    assert_eq!(entry("solver.dt")["kept"], false);
+    assert_eq!(entry("solver.dt")["scene_value"], "0.004");
+    assert!(metrics["newton_iterations"].as_u64().unwrap() <= 2 * metrics["steps"].as_u64().unwrap(), "{metrics}");
+}

@@ -61,10 +61,10 @@ fn bad_patterns_are_refused_naming_the_panel_and_the_edge() {
     // step of minutes), and springs that cannot draw the seams shut by the sewing time.
     let cases = [
         ("height = 104 }", "height = -50 }", &["'front'", "positive distance and height"][..]),
-        ("units = \"cm\"", "units = \"m\"", &["check garment.units", "m across"]),
+        ("[fabric]\npreset = \"wool\"", "[garment]\nunits = \"m\"\n\n[fabric]\npreset = \"wool\"", &["check garment.units", "m across"]),
         ("b = \"right.left\"", "b = \"front.right\"", &["garment.seams[0] sews edge 'right' of panel 'front' to itself"]),
-        ("units = \"cm\"", "units = \"cm\"\nclosed_share = 100", &["garment.closed_share = 100 is more than 1"]),
-        ("units = \"cm\"", "units = \"cm\"\nsewing_ramp = 2", &["garment.sewing_ramp = 2 s is not shorter than garment.sewing_time"]),
+        ("[fabric]\npreset = \"wool\"", "[garment]\nunits = \"cm\"\nclosed_share = 100\n\n[fabric]\npreset = \"wool\"", &["garment.closed_share = 100 is more than 1"]),
+        ("[fabric]\npreset = \"wool\"", "[garment]\nunits = \"cm\"\nsewing_ramp = 2\n\n[fabric]\npreset = \"wool\"", &["garment.sewing_ramp = 2 s is not shorter than garment.sewing_time"]),
     ];
     for (from, to, words) in cases {
         let err = refusal(&gored, from, to);
@@ -106,10 +106,10 @@ fn malformed_outlines_seams_and_forms_are_refused_naming_their_key() {
         ("around = \"cone\"", "around = \"sphere\"", &["placement.around", "expected `cone` or `plane`"]),
         // Seams, hem and attachments.
         ("direction = \"opposite\"\n", "direction = \"opposite\"\na_span = [0.8, 0.2]\n", &["garment.seams[0].a_span", "increasing stretch"]),
-        ("units = \"cm\"", "units = \"cm\"\nhem = [\"front.nothem\"]", &["garment.hem", "no edge 'nothem'", "hem, right, waist, left"]),
+        ("[fabric]\npreset = \"wool\"", "[garment]\nunits = \"cm\"\nhem = [\"front.nothem\"]\n\n[fabric]\npreset = \"wool\"", &["garment.hem", "no edge 'nothem'", "hem, right, waist, left"]),
         ("sewing_time = 1.0", "sewing_time = 1.0\n\n[[garment.attachments]]\nedge = \"front.nowaist\"\npin = true", &["garment.attachments[0].edge", "no edge 'nowaist'"]),
         ("sewing_time = 1.0", "sewing_time = 1.0\n\n[[garment.attachments]]\nedge = \"front.waist\"\nlevel = \"knee\"", &["garment.attachments[0].level", "waist, hip or bust"]),
-        ("units = \"cm\"", "units = \"cm\"\nseam_ease = -0.5", &["garment.seam_ease = -0.5", "between 0 and 0.5"]),
+        ("[fabric]\npreset = \"wool\"", "[garment]\nunits = \"cm\"\nseam_ease = -0.5\n\n[fabric]\npreset = \"wool\"", &["garment.seam_ease = -0.5", "between 0 and 0.5"]),
         ("sewing_time = 1.0", "sewing_time = -1.0", &["garment.sewing_time must be a positive number"]),
         ("sewing_time = 1.0", "sewing_tiem = 1.0", &["garment.sewing_tiem", "unknown field"]),
         // The form.

@@ -2,7 +2,7 @@
 //! a solver that runs on its own thread ([`worker`]).
 //!
 //! - [`worker`]: the solver thread, its commands and snapshots (no GUI dependency).
-//! - [`ui`]: the egui panels and the view's mouse and keys, turned into actions.
+//! - [`ui`]: the egui panels and the view's mouse and keys, turned into [`action`]s.
 //! - [`camera`]: orbit camera and ray picking; [`colour`]: strain/bending colour maps;
 //!   [`plots`]: live test plots and their references; [`files`]: TOML, OBJ, CSV;
 //!   [`chart_view`]: the speed/accuracy charts of `rosette chart`; [`card_view`]: the
@@ -10,6 +10,7 @@
 //!   one; [`pattern_view`]: a garment's grains and its flat pattern.
 //! - [`script`]: scripted sessions read and checked; [`session`]: one played in the window
 //!   through the panels' own code.
+pub mod action;
 pub mod camera;
 pub mod card_view;
 pub mod chart_view;

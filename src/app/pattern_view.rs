@@ -3,7 +3,7 @@
 //! with the grain lines and the seams' pairs (`garment::flat`). The pattern drawn follows
 //! the grains being edited before the garment is recut.
 
-use super::ui::Action;
+use super::action::Action;
 use super::worker::{Command, Snapshot};
 use crate::garment::flat::FlatPattern;
 use crate::garment::GarmentConfig;

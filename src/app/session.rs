@@ -88,6 +88,12 @@ impl Session {
         Self { script, started: Instant::now(), step: 0, step_wall: None, step_simulated: None, drag: None, screenshot: None, report: Vec::new(), round: 0, opened: None }
     }
 
+    /// Whether the session is feeding the window input (a drag under way): its frames come
+    /// as the user's input does, at once, not at the pace of the scene's snapshots.
+    pub fn feeding_input(&self) -> bool {
+        self.drag.is_some_and(|d| d.pressed && !d.released)
+    }
+
     /// The script's file, as given.
     pub fn script_name(&self) -> String {
         self.script.path.display().to_string()

@@ -10,6 +10,7 @@ use super::pattern_view::PatternView;
 use super::pin::Pinned;
 use super::colour::ColourMap;
 use super::plots::{self, History};
+pub use super::action::{Action, FileDialog};
 use super::worker::{Command, Snapshot};
 use crate::settings::{FABRICS, FabricConfig, SCENES, scene_descriptions};
 use crate::scene::{SceneConfig, load_scene};
@@ -27,32 +28,6 @@ pub const TESTS: &[&str] =
 
 /// Fabric edits are sent at most this often while a value is being dragged.
 const FABRIC_THROTTLE: Duration = Duration::from_millis(250);
-
-/// What the window must do for the UI.
-#[derive(Debug, Clone)]
-pub enum Action {
-    Send(Command),
-    /// A file to pick, then read or write.
-    File(FileDialog),
-    Screenshot,
-    /// Save the window, as F12 does, to this file (a scripted session's screenshot).
-    SaveScreenshot(std::path::PathBuf),
-    /// Keep the current fabric's picture and measures beside the live view.
-    Pin,
-}
-
-/// What a file dialog is opened for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FileDialog {
-    OpenScene,
-    SaveScene,
-    OpenFabric,
-    SaveFabric,
-    ExportObj,
-    ExportCsv,
-    /// The cloth as it is now, as glTF binary (`crate::export`).
-    ExportGltf,
-}
 
 /// A cloth point held by the mouse: it moves in the plane through the picked point facing
 /// the camera.

@@ -410,7 +410,7 @@ impl App {
             event_loop.exit();
             return;
         }
-        if self.options.quit_after_frames.is_some() {
+        if self.options.quit_after_frames.is_some() || self.session.as_ref().is_some_and(Session::feeding_input) {
             gpu.window.request_redraw();
         } else if self.session.is_some() {
             // A session's waits look at the clock even while the scene is paused.
@@ -514,6 +514,8 @@ impl App {
     fn file_action(&mut self, kind: FileDialog, path: &Path) -> Result<(), String> {
         let snapshot = self.worker.latest();
         let write = |text: String| crate::io::write::whole(path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()));
+        // Saving a scene or fabric over the file it came from is what Save is for.
+        let save = |text: String| crate::io::write::whole_chosen(path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()));
         match kind {
             FileDialog::OpenScene => {
                 let spec = path.to_string_lossy().into_owned();
@@ -521,12 +523,12 @@ impl App {
                 self.worker.send(Command::LoadScene { name: scene_label(&spec), config: Box::new(config) });
                 return Ok(());
             }
-            FileDialog::SaveScene => write(files::scene_toml(&snapshot.config)?)?,
+            FileDialog::SaveScene => save(files::scene_toml(&snapshot.config)?)?,
             FileDialog::OpenFabric => {
                 self.ui.set_fabric(files::read_fabric(path)?);
                 return Ok(());
             }
-            FileDialog::SaveFabric => write(files::fabric_toml(&snapshot.config.fabric)?)?,
+            FileDialog::SaveFabric => save(files::fabric_toml(&snapshot.config.fabric)?)?,
             FileDialog::ExportObj => write(files::mesh_obj(&snapshot.positions, &snapshot.topology.texture, &snapshot.topology.triangles))?,
             FileDialog::ExportCsv => write(files::measures_csv(&snapshot.measures, &self.ui.history.names, &self.ui.history.rows))?,
             FileDialog::ExportGltf => {

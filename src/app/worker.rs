@@ -138,6 +138,8 @@ pub enum DrapeCause {
     Grain,
     /// The other solver path.
     Path,
+    /// The mouse pulled a cloth that had come to rest.
+    Drag,
 }
 
 impl DrapeCause {
@@ -148,6 +150,7 @@ impl DrapeCause {
             Self::Fabric => "fabric switch",
             Self::Grain => "recut",
             Self::Path => "path switch",
+            Self::Drag => "drag",
         }
     }
 }
@@ -477,7 +480,8 @@ impl WorkerState {
                 if self.drag.is_some() {
                     self.settle.interrupt();
                 }
-                if end && !self.finished {
+                // Not while the mouse holds the cloth: the drag goes on past the end.
+                if end && !self.finished && self.drag.is_none() {
                     self.finished = true;
                     self.playing = false;
                 }
@@ -653,9 +657,12 @@ impl WorkerState {
         // settles again once let go; one the user paused stays paused.
         if !self.playing && !self.user_paused {
             self.playing = true;
-            self.paused_settled = false;
+            (self.paused_settled, self.finished) = (false, false);
             self.settle = SettleWatch::new(&self.scene);
             self.pace = (Instant::now(), self.scene.state.time);
+            // A new drape, from the drag: the scene's duration counts from here.
+            let from_sewn = self.scene.garment.as_ref().is_some_and(|g| g.is_sewn());
+            self.drape = (DrapeClock { cause: DrapeCause::Drag, started_at: self.scene.state.time, from_sewn, ..DrapeClock::default() }, Instant::now());
         }
     }
 

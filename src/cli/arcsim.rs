@@ -1,10 +1,10 @@
 //! `rosette fabric export --arcsim`: a fabric written as an ARCSim material file.
 
 use super::outputs::{self, ARCSIM_FILE};
-use super::{bad_input, lost_output};
+use super::bad_input;
 use rosette::fabric::arcsim::export::{export as to_material, to_json};
 use rosette::io::guard::Plan;
-use rosette::{errln, out};
+use rosette::errln;
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -42,17 +42,5 @@ pub fn export(spec: &str, out: Option<&Path>, force: bool) -> ExitCode {
         comments.push(format!("Measured by {who}; cite their publication with the data."));
     }
     let text = to_json(&material, &comments);
-    match out {
-        Some(path) => match rosette::io::write::whole(path, text.as_bytes()) {
-            Ok(()) => {
-                errln!("wrote {}", path.display());
-                ExitCode::SUCCESS
-            }
-            Err(e) => lost_output(format!("--out {}: cannot write the material: {e}", path.display())),
-        },
-        None => {
-            out!("{text}");
-            ExitCode::SUCCESS
-        }
-    }
+    outputs::write_or_print(out, &text, "the material", "")
 }

@@ -2,7 +2,7 @@
 //! the virtual laboratory's check.
 
 use super::outputs::{self, FABRIC_FILE};
-use super::{EXIT_DIVERGED, EXIT_READBACK, bad_input, lost_output, say_error};
+use super::{EXIT_DIVERGED, EXIT_READBACK, bad_input, say_error};
 use rosette::fabric::{SheetKind, load_fabric, write};
 use rosette::io::guard::Plan;
 use rosette::{errln, out, outln};
@@ -66,19 +66,7 @@ pub fn import(sheet: &str, out: Option<&Path>, force: bool) -> ExitCode {
         Err(e) => return bad_input(e),
     };
     let text = write::fabric_file(&table, &loaded.sheets, &loaded.import, sheet);
-    match out {
-        Some(path) => match rosette::io::write::whole(path, text.as_bytes()) {
-            Ok(()) => {
-                errln!("wrote {}", path.display());
-                ExitCode::SUCCESS
-            }
-            Err(e) => lost_output(format!("--out {}: cannot write the fabric file: {e}", path.display())),
-        },
-        None => {
-            out!("{text}");
-            ExitCode::SUCCESS
-        }
-    }
+    outputs::write_or_print(out, &text, "the fabric file", "")
 }
 
 pub fn check(fabric: &str) -> ExitCode {

@@ -31,6 +31,9 @@ pub const EXIT_STOPPED: u8 = 6;
 pub const EXIT_READBACK: u8 = 7;
 /// A garment whose seams were still open at `garment.sewing_time`: not finished.
 pub const EXIT_NOT_SEWN: u8 = 8;
+/// A sewn garment that did not end hanging on its form (slid off, fell, ended inside it):
+/// its drape measures are withheld.
+pub const EXIT_OFF_FORM: u8 = 9;
 
 /// Says an error on standard error, its numbers to a few figures (a value of 1e300 quoted
 /// as its 301 digits helps nobody).

@@ -4,7 +4,7 @@
 //! any work.
 
 use rosette::io::guard::{Kind, Plan, Signature};
-use rosette::io::read::{FileKind, Identity, files_read, file_id};
+use rosette::io::read::{Identity, files_read, file_id};
 use rosette::scene::{SceneConfig, StepRecord};
 use std::path::Path;
 
@@ -26,17 +26,15 @@ pub const ARCSIM_FILE: Kind = Kind { noun: "an ARCSim material", signature: Sign
 pub const PATTERN_SCENE: Kind = Kind { noun: "an imported garment scene", signature: Signature::SecondLine("# Written by `rosette pattern import") };
 pub const FABRIC_FILE: Kind = Kind { noun: "a fabric file", signature: Signature::SecondLine("# Written by `rosette fabric import") };
 
-/// The files a command read (scenes, fabrics, sheets), with the meshes its scene's props
-/// name, which are read only when the scene is built.
+/// The files a command read (scenes, fabrics, sheets, through `rosette::io::read`), with
+/// those its scenes will read when they are built ([`rosette::scene::props::files_named`]).
 pub fn inputs(configs: &[&SceneConfig]) -> Vec<Identity> {
     let mut inputs = files_read();
     for config in configs {
-        for prop in &config.props {
-            let Some(file) = prop.file.as_deref() else { continue };
-            let path = rosette::scene::props::obj_path(file, config.base_dir.as_deref());
+        for (path, kind) in rosette::scene::props::files_named(config) {
             if file_id(&path).is_some() {
                 let canonical = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
-                inputs.push(Identity { id: file_id(&path), path, canonical, kind: FileKind::Obj });
+                inputs.push(Identity { id: file_id(&path), path, canonical, kind });
             }
         }
     }
@@ -54,4 +52,22 @@ pub fn folder(flag: &str, dir: &Path) -> Result<(), String> {
         return Err(format!("{flag} {}: is a file; {flag} names a folder to write into", dir.display()));
     }
     std::fs::create_dir_all(dir).map_err(|e| format!("{flag} {}: cannot write there (cannot create the folder: {e})", dir.display()))
+}
+
+/// Writes `text` to `--out PATH`, whole or not at all, or without `--out` to standard
+/// output: `noun` names it in the error ("the material"), `hint` follows "wrote PATH".
+pub fn write_or_print(out: Option<&Path>, text: &str, noun: &str, hint: &str) -> std::process::ExitCode {
+    match out {
+        Some(path) => match rosette::io::write::whole(path, text.as_bytes()) {
+            Ok(()) => {
+                rosette::errln!("wrote {}{hint}", path.display());
+                std::process::ExitCode::SUCCESS
+            }
+            Err(e) => super::lost_output(format!("--out {}: cannot write {noun}: {e}", path.display())),
+        },
+        None => {
+            rosette::out!("{text}");
+            std::process::ExitCode::SUCCESS
+        }
+    }
 }

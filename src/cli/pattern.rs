@@ -1,12 +1,12 @@
 //! `rosette pattern import`: a GarmentCode pattern specification as a garment scene file.
 
 use super::outputs::{self, PATTERN_SCENE};
-use super::{bad_input, lost_output};
+use super::bad_input;
 use rosette::garment::form::FormConfig;
 use rosette::garment::garmentcode::{ImportOptions, import as import_spec, scene_text};
 use rosette::io::guard::Plan;
 use rosette::io::read::{FileKind, read_text};
-use rosette::{errln, out};
+use rosette::errln;
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -54,17 +54,20 @@ pub fn import(spec: &Path, out: Option<&Path>, form: &str, fabric: &str, grain_d
         Ok(t) => t,
         Err(e) => return bad_input(e),
     };
-    match out {
-        Some(path) => match rosette::io::write::whole(path, text.as_bytes()) {
-            Ok(()) => {
-                errln!("wrote {}; run it with `rosette run {}`", path.display(), path.display());
-                ExitCode::SUCCESS
-            }
-            Err(e) => lost_output(format!("--out {}: cannot write the scene file: {e}", path.display())),
-        },
-        None => {
-            out!("{text}");
-            ExitCode::SUCCESS
-        }
+    if let Err(e) = loads_as_written(&text, &name) {
+        return bad_input(format!("{source}: the scene it imports to is refused: {e}"));
     }
+    outputs::write_or_print(out, &text, "the scene file", &format!("; run it with `rosette run {}`", out.map_or_else(String::new, |p| p.display().to_string())))
+}
+
+/// Loads the scene text an import is about to write as `rosette run` will load it (every
+/// check, the fabric, the form, the plan), so that an import never writes a scene that a
+/// run then refuses. The text goes through a file of its own in the temporary folder,
+/// removed after.
+fn loads_as_written(text: &str, name: &str) -> Result<(), String> {
+    let path = std::env::temp_dir().join(format!("rosette-import-{}-{name}.toml", std::process::id()));
+    std::fs::write(&path, text).map_err(|e| format!("cannot check it in {}: {e}", path.display()))?;
+    let loaded = rosette::scene::load_scene(&path.to_string_lossy(), &[]);
+    std::fs::remove_file(&path).ok();
+    loaded.map(drop).map_err(|e| e.to_string().replace(&path.display().to_string(), "the imported scene"))
 }

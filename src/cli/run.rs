@@ -2,7 +2,7 @@
 //! after it, and an exit code that says how it ended.
 
 use super::outputs::{self, GLTF, METRICS, OUTLINE, PICTURE, STEP_LOG};
-use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, EXIT_NOT_CONVERGED, EXIT_NOT_SEWN, EXIT_STOPPED, bad_input, say_error};
+use super::{EXIT_DIVERGED, EXIT_NO_OUTPUT, EXIT_NOT_CONVERGED, EXIT_NOT_SEWN, EXIT_OFF_FORM, EXIT_STOPPED, bad_input, say_error};
 use super::args::{DEFAULT_MAX_WALL, ScreenshotArgs};
 use rosette::io::guard::Plan;
 use rosette::io::number::short;
@@ -117,6 +117,40 @@ fn prepare(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
     Ok(scene)
 }
 
+/// Bounds the work before the first step (reading, checking, meshing, building the
+/// model) by `--max-wall` and by Ctrl-C: past the bound, or on a signal, the process says
+/// so and exits (6, or 128 + the signal) with nothing written, for nothing has been yet.
+/// The checks refuse what they can estimate; this bounds what they cannot.
+struct Watchdog {
+    done: Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl Watchdog {
+    fn start(limit: f64) -> Watchdog {
+        let done = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let flag = Arc::clone(&done);
+        let started = std::time::Instant::now();
+        std::thread::spawn(move || {
+            while !flag.load(std::sync::atomic::Ordering::SeqCst) {
+                if let Some(signal) = rosette::io::interrupt::received() {
+                    say_error(format!("stopped by {} while preparing the scene; nothing was run or written", rosette::io::interrupt::name(signal)));
+                    std::process::exit(128 + signal);
+                }
+                if started.elapsed().as_secs_f64() > limit {
+                    say_error(format!("stopped after {limit} s of wall time preparing the scene, the bound --max-wall (raise it); nothing was run or written"));
+                    std::process::exit(i32::from(EXIT_STOPPED));
+                }
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+        });
+        Watchdog { done }
+    }
+
+    fn stop(self) {
+        self.done.store(true, std::sync::atomic::Ordering::SeqCst);
+    }
+}
+
 /// Creates the step log (staged beside its name until the run ends) and writes its header.
 fn open_step_log(path: &Path) -> Result<Output, String> {
     let mut out = Output::open(path).map_err(|e| format!("--step-log {}: cannot create it: {e}", path.display()))?;
@@ -141,7 +175,11 @@ fn progress_bar(name: &str) -> Option<indicatif::ProgressBar> {
 
 pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOutputs, shot: &ScreenshotArgs) -> ExitCode {
     let building = std::time::Instant::now();
-    let mut scene = match prepare(spec, overrides, limits, outputs, shot) {
+    rosette::io::interrupt::catch();
+    let watch = Watchdog::start(limits.max_wall);
+    let prepared = prepare(spec, overrides, limits, outputs, shot);
+    watch.stop();
+    let mut scene = match prepared {
         Ok(scene) => scene,
         Err(e) => return bad_input(e),
     };
@@ -250,7 +288,9 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
 }
 
 /// The exit code and its message: the run's own outcome first (a diverged, cut-short or
-/// unconverged run is what the caller most needs to know), then a lost output.
+/// unconverged run is what the caller most needs to know), then a lost output, then what
+/// the garment came to (not sewn): results the user cannot find outrank results that are
+/// there and say they are unfinished.
 fn outcome(name: &str, scene: &Scene, metrics: &rosette::scene::Metrics, error: Option<rosette::sim::StepError>, output_failed: bool) -> ExitCode {
     if let Some(e) = error {
         say_error(&e);
@@ -258,7 +298,8 @@ fn outcome(name: &str, scene: &Scene, metrics: &rosette::scene::Metrics, error: 
     }
     if let Some(reason) = &metrics.stopped_at_limit {
         say_error(format!("{name}: {reason}; the results cover {:.4} s", metrics.simulated_seconds));
-        return ExitCode::from(EXIT_STOPPED);
+        let signal = rosette::io::interrupt::received().and_then(|s| u8::try_from(128 + s).ok());
+        return ExitCode::from(signal.unwrap_or(EXIT_STOPPED));
     }
     if !metrics.converged {
         errln!(
@@ -271,6 +312,7 @@ fn outcome(name: &str, scene: &Scene, metrics: &rosette::scene::Metrics, error: 
         );
         return ExitCode::from(EXIT_NOT_CONVERGED);
     }
+    let lost = ExitCode::from(EXIT_NO_OUTPUT);
     if let Some(garment) = metrics.measures.garment().filter(|g| !g.sewn) {
         let sewing_time = scene.config.garment.as_ref().map_or(f64::INFINITY, |g| g.sewing_time);
         let ended = scene.state.time;
@@ -290,12 +332,13 @@ fn outcome(name: &str, scene: &Scene, metrics: &rosette::scene::Metrics, error: 
             )
         };
         say_error(message);
-        return ExitCode::from(EXIT_NOT_SEWN);
+        return if output_failed { lost } else { ExitCode::from(EXIT_NOT_SEWN) };
     }
-    if output_failed {
-        return ExitCode::from(EXIT_NO_OUTPUT);
+    if let Some(reason) = metrics.measures.garment().and_then(|g| g.off_form.as_ref()) {
+        say_error(format!("{name}: {reason}"));
+        return if output_failed { lost } else { ExitCode::from(EXIT_OFF_FORM) };
     }
-    ExitCode::SUCCESS
+    if output_failed { lost } else { ExitCode::SUCCESS }
 }
 
 /// What to change when Newton stops short: the limits the scene lowered below their

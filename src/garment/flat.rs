@@ -115,8 +115,10 @@ impl FlatPattern {
 mod tests {
     use super::*;
 
-    fn garment(text: &str) -> GarmentConfig {
-        let table: toml::Table = text.parse().unwrap();
+    /// The `[garment]` of a bundled scene, over its bundled base.
+    fn garment(name: &str) -> GarmentConfig {
+        let bundled = crate::settings::SCENES.iter().find(|s| s.name == name).unwrap();
+        let (table, _) = crate::settings::read::with_base(bundled.text.parse().unwrap(), name).unwrap();
         toml::Value::Table(table["garment"].as_table().unwrap().clone()).try_into().unwrap()
     }
 
@@ -125,7 +127,7 @@ mod tests {
     /// they name start or end; a grain override turns only the grain.
     #[test]
     fn the_gored_skirt_lies_flat_with_its_seams_on_their_edges() {
-        let config = garment(include_str!("../../presets/skirt-gored-straight.toml"));
+        let config = garment("skirt-gored-straight");
         let flat = FlatPattern::new(&config, None).unwrap();
         assert_eq!(flat.panels.len(), config.panels.len());
         for w in flat.panels.windows(2) {

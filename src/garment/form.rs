@@ -145,8 +145,56 @@ fn check_measurements(m: &Measurements, units: Units) -> Result<(), String> {
     if m.neck_girth >= m.waist_girth || m.waist_girth >= m.bust_girth.max(m.hip_girth) {
         return Err("measurements: the waist must be narrower than the bust or the hip, and the neck than the waist".into());
     }
+    check_proportions(m, units)
+}
+
+/// The checks between fields, which the form's sections need in order: the shoulders
+/// (`SHOULDER_DROP` under the nape) above the top of the bust (`BUST_TOP` over the bust
+/// point), shoulders no wider than half the bust girth (the back's share of it), the
+/// nape within a standing body's height, the hip section under it above the floor.
+fn check_proportions(m: &Measurements, units: Units) -> Result<(), String> {
+    let k = units.metres();
+    let shown = |v: f64| format!("{} {}", crate::io::number::short(v / k), units.name());
+    let nape = m.waist_height + m.torso_length;
+    let least_torso = m.bust_height - m.waist_height + BUST_TOP + SHOULDER_DROP + 0.01;
+    if m.torso_length < least_torso {
+        return Err(format!(
+            "measurements.torso_length = {} is shorter than the bust point's height over the waist ({}) and the shoulders above it need: \
+             give at least {}, or lower bust_height",
+            shown(m.torso_length),
+            shown(m.bust_height - m.waist_height),
+            shown(least_torso)
+        ));
+    }
+    if m.shoulder_width > 0.5 * m.bust_girth {
+        return Err(format!(
+            "measurements.shoulder_width = {} is more than half the bust girth ({}): the back would be wider than the body around it; \
+             measure from shoulder point to shoulder point across the back",
+            shown(m.shoulder_width),
+            shown(0.5 * m.bust_girth)
+        ));
+    }
+    if nape > MAX_NAPE_HEIGHT {
+        return Err(format!(
+            "measurements: waist_height + torso_length = {} puts the nape higher than a standing body's ({}); check the units ({})",
+            shown(nape),
+            shown(MAX_NAPE_HEIGHT),
+            units.name()
+        ));
+    }
+    if m.hip_height < HIP_DEPTH + 0.01 {
+        return Err(format!("measurements.hip_height = {} leaves no room for the form under the hip; give at least {}", shown(m.hip_height), shown(HIP_DEPTH + 0.01)));
+    }
     Ok(())
 }
+
+/// The form's sections past the measured ones: the top of the bust over the bust point,
+/// the shoulders under the nape, the form's lowest section under the hip, m.
+const BUST_TOP: f64 = 0.08;
+const SHOULDER_DROP: f64 = 0.045;
+const HIP_DEPTH: f64 = 0.16;
+/// The nape of a standing body 2.7 m tall (beyond the tallest recorded).
+const MAX_NAPE_HEIGHT: f64 = 2.3;
 
 /// One horizontal section of the form: its height and half-axes along x (across the body)
 /// and y (front to back), m.
@@ -176,12 +224,12 @@ fn sections(m: &Measurements) -> Vec<Section> {
     let neck_base = m.waist_height + m.torso_length;
     let neck_radius = m.neck_girth / std::f64::consts::TAU;
     vec![
-        ellipse(m.hip_height - 0.16, 0.93 * m.hip_girth, SECTION_RATIO),
+        ellipse(m.hip_height - HIP_DEPTH, 0.93 * m.hip_girth, SECTION_RATIO),
         ellipse(m.hip_height, m.hip_girth, SECTION_RATIO),
         ellipse(m.waist_height, m.waist_girth, SECTION_RATIO),
         ellipse(m.bust_height, m.bust_girth, SECTION_RATIO),
-        ellipse(m.bust_height + 0.08, 0.96 * m.bust_girth, 0.72),
-        Section { z: neck_base - 0.045, half_width: 0.5 * m.shoulder_width, half_depth: 0.055 },
+        ellipse(m.bust_height + BUST_TOP, 0.96 * m.bust_girth, 0.72),
+        Section { z: neck_base - SHOULDER_DROP, half_width: 0.5 * m.shoulder_width, half_depth: 0.055 },
         Section { z: neck_base, half_width: neck_radius, half_depth: neck_radius },
         Section { z: neck_base + 0.07, half_width: neck_radius, half_depth: neck_radius },
     ]
@@ -275,5 +323,27 @@ mod tests {
                 assert!((perimeter / girth - 1.0).abs() < 0.01, "{name} {level}: {perimeter} vs {girth}");
             }
         }
+    }
+
+    /// Measurements that each lie in a body's range but contradict each other are refused,
+    /// naming the field; every bundled size passes, and every accepted form is finite.
+    #[test]
+    fn measurements_that_contradict_each_other_are_refused() {
+        for (name, m) in SIZES {
+            check_measurements(m, Units::M).unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+        let base = SIZES[0].1;
+        let cases: [(&str, Measurements); 4] = [
+            ("torso_length", Measurements { torso_length: 0.15, ..base }),
+            ("shoulder_width", Measurements { shoulder_width: 0.6, ..base }),
+            ("nape", Measurements { waist_height: 2.0, bust_height: 2.2, hip_height: 1.8, ..base }),
+            ("hip_height", Measurements { hip_height: 0.1, ..base }),
+        ];
+        for (field, m) in cases {
+            let err = check_measurements(&m, Units::M).unwrap_err();
+            assert!(err.contains(field), "{field}: {err}");
+        }
+        let (vertices, _) = form_mesh(&base);
+        assert!(vertices.iter().all(|v| v.is_finite()));
     }
 }

@@ -41,11 +41,45 @@ struct Spec {
 
 #[derive(Deserialize)]
 struct SpecPattern {
-    panels: BTreeMap<String, SpecPanel>,
+    panels: UniqueKeys<SpecPanel>,
     #[serde(default)]
     stitches: Vec<Vec<Value>>,
     #[serde(default)]
     panel_order: Option<Vec<String>>,
+}
+
+/// A JSON object whose keys must differ: serde_json keeps the last of two equal keys,
+/// which would drop a panel in silence.
+struct UniqueKeys<V>(BTreeMap<String, V>);
+
+impl<'de, V: Deserialize<'de>> Deserialize<'de> for UniqueKeys<V> {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Visit<V>(std::marker::PhantomData<V>);
+        impl<'de, V: Deserialize<'de>> serde::de::Visitor<'de> for Visit<V> {
+            type Value = UniqueKeys<V>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an object of panels by name")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+                let mut out = BTreeMap::new();
+                while let Some((name, value)) = map.next_entry::<String, V>()? {
+                    if out.contains_key(&name) {
+                        return Err(serde::de::Error::custom(format!("two panels are named '{name}'; give each its own name")));
+                    }
+                    out.insert(name, value);
+                }
+                Ok(UniqueKeys(out))
+            }
+        }
+        deserializer.deserialize_map(Visit(std::marker::PhantomData))
+    }
+}
+
+impl<V> std::ops::Deref for UniqueKeys<V> {
+    type Target = BTreeMap<String, V>;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
 }
 
 #[derive(Deserialize, Default)]
@@ -97,35 +131,6 @@ impl Default for ImportOptions {
 /// The fabric an imported garment is made of unless one is named.
 pub const DEFAULT_FABRIC: &str = "cotton-shirting";
 
-/// The scene around an imported pattern: the bundled garments' settings (docs/garments.md),
-/// the mesh at 2 cm.
-const SCENE: &str = r#"kind = "garment"
-duration = 6.0
-gravity_ramp = 1.5
-settle_speed = 1e-3
-settle_window = 0.3
-
-[physics]
-compression_buckling = true
-
-[mesh]
-edge_length = 0.02
-
-[solver]
-integrator = "implicit-euler"
-dt = 0.004
-damping = 4.0
-
-[solver.newton]
-max_iterations = 100
-
-[contact]
-thickness = 0.002
-friction_static = 0.5
-friction_kinetic = 0.4
-self_collision = true
-"#;
-
 /// The scene file of an imported garment named `name`, read from `source`, in `fabric`.
 pub fn scene_text(imported: &Imported, source: &str, name: &str, fabric: &str) -> Result<String, GarmentError> {
     #[derive(serde::Serialize)]
@@ -140,8 +145,10 @@ pub fn scene_text(imported: &Imported, source: &str, name: &str, fabric: &str) -
     Ok(format!(
         "# {name}: a garment imported from GarmentCode's pattern specification {}\n\
          # Written by `rosette pattern import` ({panels} panels, {seams} seams). Lengths in [garment] are in cm;\n\
-         # each panel starts where GarmentCode places it, on a vertical plane facing out.\n\
-         [scene]\ndescription = \"{name} ({panels} panels, from GarmentCode) in {fabric}\"\n{SCENE}\n[fabric]\npreset = \"{fabric}\"\npoisson_warp = 0.0\n\n{garment}",
+         # each panel starts where GarmentCode places it, on a vertical plane facing out. Every other\n\
+         # setting is a garment's (presets/bases/garment.toml in the repository).\n\
+         base = \"garment\"\n\n\
+         [scene]\ndescription = \"{name} ({panels} panels, from GarmentCode) in {fabric}\"\n\n[fabric]\npreset = \"{fabric}\"\n\n{garment}",
         source.replace(['\n', '\r'], " "),
     ))
 }
@@ -609,6 +616,9 @@ mod tests {
         let tilted = SPEC.replace(r#""rotation": [0, 0, -50]"#, r#""rotation": [30, 0, 0]"#);
         let e = import(&tilted, "x.json", &options()).err().unwrap().message;
         assert!(e.contains("panel 'sleeve'") && e.contains("vertical"), "{e}");
+        let twice = SPEC.replace(r#""sleeve": {"#, r#""front": {"#);
+        let e = import(&twice, "x.json", &options()).err().unwrap().message;
+        assert!(e.contains("two panels are named 'front'"), "{e}");
         let unknown = SPEC.replace(r#""type": "cubic""#, r#""type": "spline""#);
         let e = import(&unknown, "x.json", &options()).err().unwrap().message;
         assert!(e.contains("panel 'back'") && e.contains("edge 2") && e.contains("spline"), "{e}");

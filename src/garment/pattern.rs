@@ -228,24 +228,12 @@ fn bezier(p0: DVec2, p1: DVec2, p2: DVec2, p3: DVec2) -> Vec<DVec2> {
 
 /// Refuses an outline that crosses itself, naming the panel and the two edges.
 pub fn check_simple(panel: &str, names: &[&str], curves: &[Polyline]) -> Result<(), GarmentError> {
-    // Every segment with its edge; segments that share an end point (neighbours along the
-    // outline) are not tested against each other.
     let segments: Vec<(usize, DVec2, DVec2)> = curves.iter().enumerate().flat_map(|(e, c)| c.points.windows(2).map(move |w| (e, w[0], w[1]))).collect();
-    let n = segments.len();
-    for i in 0..n {
-        for j in i + 2..n {
-            if i == 0 && j == n - 1 {
-                continue;
-            }
-            let (ei, a, b) = segments[i];
-            let (ej, c, d) = segments[j];
-            if segments_cross(a, b, c, d) {
-                return Err(GarmentError::new(format!(
-                    "garment.panels '{panel}': the outline crosses itself where edge '{}' meets edge '{}'; a panel must be a simple closed shape",
-                    names[ei], names[ej]
-                )));
-            }
-        }
+    if let Some((i, j)) = first_crossing(&segments) {
+        return Err(GarmentError::new(format!(
+            "garment.panels '{panel}': the outline crosses itself where edge '{}' meets edge '{}'; a panel must be a simple closed shape",
+            names[segments[i].0], names[segments[j].0]
+        )));
     }
     let area: f64 = curves.iter().flat_map(|c| c.points.windows(2)).map(|w| 0.5 * w[0].perp_dot(w[1])).sum();
     if area <= 0.0 {
@@ -254,6 +242,49 @@ pub fn check_simple(panel: &str, names: &[&str], curves: &[Polyline]) -> Result<
         )));
     }
     Ok(())
+}
+
+/// The first pair of segments of a closed outline that cross, leaving out neighbours along
+/// the outline (which share an end point). The segments are binned in a square grid of
+/// about one segment per cell, and only those sharing a cell are tested: linear in the
+/// outline's length where all-pairs took minutes on an outline of a few hundred edges
+/// (each sampled into hundreds of segments).
+fn first_crossing(segments: &[(usize, DVec2, DVec2)]) -> Option<(usize, usize)> {
+    let n = segments.len();
+    if n < 4 {
+        return None;
+    }
+    let (lo, hi) = segments.iter().fold((DVec2::MAX, DVec2::MIN), |(lo, hi), &(_, a, b)| (lo.min(a).min(b), hi.max(a).max(b)));
+    let extent = (hi - lo).max_element().max(1e-12);
+    let side = (n as f64).sqrt().ceil().clamp(1.0, 4096.0);
+    let cell = extent / side;
+    let index = |p: DVec2| ((p - lo) / cell).floor().clamp(DVec2::ZERO, DVec2::splat(side - 1.0)).as_uvec2();
+    let mut bins: std::collections::HashMap<(u32, u32), Vec<usize>> = std::collections::HashMap::new();
+    for (k, &(_, a, b)) in segments.iter().enumerate() {
+        let (c0, c1) = (index(a.min(b)), index(a.max(b)));
+        for x in c0.x..=c1.x {
+            for y in c0.y..=c1.y {
+                bins.entry((x, y)).or_default().push(k);
+            }
+        }
+    }
+    let neighbours = |i: usize, j: usize| j == i + 1 || (i == 0 && j == n - 1);
+    let mut found: Option<(usize, usize)> = None;
+    for members in bins.values() {
+        for (p, &i) in members.iter().enumerate() {
+            for &j in &members[p + 1..] {
+                let (i, j) = (i.min(j), i.max(j));
+                if neighbours(i, j) || found.is_some_and(|f| f <= (i, j)) {
+                    continue;
+                }
+                let ((_, a, b), (_, c, d)) = (segments[i], segments[j]);
+                if segments_cross(a, b, c, d) {
+                    found = Some((i, j));
+                }
+            }
+        }
+    }
+    found
 }
 
 /// Whether segments ab and cd intersect (touching included).
@@ -278,6 +309,41 @@ mod tests {
         // The other way round, through the lower half.
         let arc = Polyline::new(arc_through(DVec2::new(1.0, 0.0), DVec2::new(0.0, -1.0), DVec2::new(-1.0, 0.0)).unwrap());
         assert!(arc.points[SAMPLES / 2].y < -0.99);
+    }
+
+    /// The grid finds what all pairs find: a wavy ring of many short segments is simple, a
+    /// circle with two points visited in the wrong order is not.
+    #[test]
+    fn the_crossing_check_agrees_with_all_pairs() {
+        let all_pairs = |s: &[(usize, DVec2, DVec2)]| {
+            let n = s.len();
+            (0..n).flat_map(|i| (i + 2..n).map(move |j| (i, j))).find(|&(i, j)| !(i == 0 && j == n - 1) && segments_cross(s[i].1, s[i].2, s[j].1, s[j].2))
+        };
+        let ring = |k: usize, bend: bool| {
+            // A wavy ring, or a circle with two points visited in the wrong order: the two
+            // chords beside them cross (the diagonals of a convex quadrilateral).
+            let wave = if bend { 0.0 } else { 0.3 };
+            let mut points: Vec<DVec2> = (0..k)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * i as f64 / k as f64;
+                    (1.0 + wave * (7.0 * t).sin()) * DVec2::from_angle(t)
+                })
+                .collect();
+            if bend {
+                points.swap(k / 2, k / 2 + 1);
+            }
+            (0..k).map(|i| (i, points[i], points[(i + 1) % k])).collect::<Vec<_>>()
+        };
+        for k in [5, 40, 700] {
+            for bend in [false, true] {
+                let s = ring(k, bend);
+                assert_eq!(first_crossing(&s).is_some(), bend, "{k} segments, bent {bend}");
+                assert_eq!(all_pairs(&s).is_some(), bend, "{k} segments, bent {bend}");
+            }
+        }
+        let star: Vec<DVec2> = (0..9).map(|i| DVec2::from_angle(std::f64::consts::TAU * (4 * i) as f64 / 9.0)).collect();
+        let s: Vec<_> = (0..9).map(|i| (i, star[i], star[(i + 1) % 9])).collect();
+        assert!(first_crossing(&s).is_some() && all_pairs(&s).is_some(), "a nine-pointed star crosses itself");
     }
 
     #[test]

@@ -126,6 +126,10 @@ impl Plan {
     /// One output on its own; true where it is a stream (written directly).
     fn check_one(&self, out: &Planned, inputs: &[Identity]) -> Result<bool, String> {
         let shown = format!("{} {}", out.flag, out.path.display());
+        let text = out.path.as_os_str().to_string_lossy();
+        if text.is_empty() || text.ends_with(std::path::MAIN_SEPARATOR) || out.path.file_name().is_none() || text.ends_with("/.") {
+            return Err(format!("{shown}: names a folder, not a file; give the name of a file to write, in that folder or another"));
+        }
         let metadata = match std::fs::metadata(&out.path) {
             Ok(m) => m,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
@@ -212,6 +216,27 @@ mod tests {
             let err = plan(true, &[("--metrics", &link, METRICS)]).check(&inputs).unwrap_err();
             assert!(err.contains("scene file this command reads"), "{err}");
         }
+    }
+
+    /// A path that can only be a folder is refused before the run, not when it is written.
+    #[test]
+    fn an_output_named_as_a_folder_is_refused_before_any_work() {
+        let dir = temp("folder-out");
+        for shown in [format!("{}/", dir.display()), format!("{}/.", dir.display()), format!("{}/..", dir.display())] {
+            let err = plan(false, &[("--metrics", Path::new(&shown), METRICS)]).check(&[]).unwrap_err();
+            assert!(err.contains("names a folder") || err.contains("is a folder"), "{shown}: {err}");
+        }
+    }
+
+    /// Whatever a command's check knew, a file it read is not replaced by its writes.
+    #[test]
+    fn a_file_that_was_read_is_never_written() {
+        let input = temp("read-then-written.toml");
+        std::fs::write(&input, "[scene]\n").unwrap();
+        read_text(&input, FileKind::Scene).unwrap();
+        let err = crate::io::write::whole(&input, b"{}").unwrap_err().to_string();
+        assert!(err.contains("this command read"), "{err}");
+        assert_eq!(std::fs::read_to_string(&input).unwrap(), "[scene]\n");
     }
 
     #[test]

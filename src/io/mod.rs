@@ -13,10 +13,12 @@
 //! - [`stdout`]: printing that neither panics nor lies: a closed pipe ends the printing
 //!   quietly, a full disk is reported once with the exit code for a lost output.
 //! - [`number`]: numbers in messages, to a few significant figures.
+//! - [`interrupt`]: Ctrl-C and SIGTERM as a request to stop a run at the end of a step.
 //!
 //! docs/robustness.md is the user's account of all of it.
 
 pub mod guard;
+pub mod interrupt;
 pub mod number;
 pub mod read;
 pub mod stdout;

@@ -102,9 +102,12 @@ pub struct Identity {
 
 impl Identity {
     /// Whether `other` is this file (same device and inode, or the same canonical path).
+    ///
+    /// An input removed since it was read is no longer anything: its inode may have gone to
+    /// a new file.
     pub fn same_file(&self, other: &Path) -> bool {
         match (self.id, file_id(other)) {
-            (Some(a), Some(b)) => a == b,
+            (Some(a), Some(b)) => a == b && file_id(&self.canonical) == Some(a),
             _ => std::fs::canonicalize(other).is_ok_and(|c| c == self.canonical),
         }
     }

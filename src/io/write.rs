@@ -122,7 +122,19 @@ impl Output {
     /// Starts writing `path`: a regular file (or a new one) is staged beside its target,
     /// the file a link points to (the link stays); a stream is opened; a folder or any
     /// other kind of file is an error.
+    /// A file this process has read (any reader goes through [`super::read::read_text`],
+    /// which keeps the list) is never written: the last guard of inputs, behind the
+    /// command's check before the run.
     pub fn open(path: &Path) -> std::io::Result<Output> {
+        if let Some(input) = super::read::files_read().into_iter().find(|input| input.same_file(path)) {
+            return Err(std::io::Error::other(format!("it is the {} this command read; give the output another name", input.kind.noun())));
+        }
+        Self::open_chosen(path)
+    }
+
+    /// As [`Output::open`], for a file the user chose in a save dialog, which may be one
+    /// the viewer read (saving the scene or fabric it opened).
+    pub fn open_chosen(path: &Path) -> std::io::Result<Output> {
         match std::fs::metadata(path) {
             Ok(m) if m.is_file() => Ok(Output::Staged(Staged::create(&std::fs::canonicalize(path)?)?)),
             Ok(m) if is_stream(&m.file_type()) => Ok(Output::Stream(std::io::BufWriter::new(open_stream(path)?))),
@@ -159,6 +171,13 @@ impl Write for Output {
 /// Writes `bytes` to `path` whole or not at all.
 pub fn whole(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let mut out = Output::open(path)?;
+    out.write_all(bytes)?;
+    out.finish()
+}
+
+/// Writes `bytes` whole to a file the user chose in a save dialog ([`Output::open_chosen`]).
+pub fn whole_chosen(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut out = Output::open_chosen(path)?;
     out.write_all(bytes)?;
     out.finish()
 }

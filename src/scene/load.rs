@@ -41,7 +41,9 @@ struct Sources {
 impl Sources {
     /// The file or `--set` a bad value at `key` (dotted, array indices dropped) came from.
     fn blame(&self, key: &[String]) -> String {
-        let overlaps = |path: &[String]| path.iter().zip(key).all(|(a, b)| a == b);
+        // `--set garment.panels[1].grain_deg=…` is a path with an index; the key has none.
+        let unindexed = |part: &String| part.split('[').next().unwrap_or(part).to_string();
+        let overlaps = |path: &[String]| path.iter().zip(key).all(|(a, b)| unindexed(a) == *b);
         if let Some((_, text)) = self.overrides.iter().rev().find(|(path, _)| overlaps(path)) {
             return text.clone();
         }
@@ -153,7 +155,8 @@ pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, Stri
 
 /// [`load_scene`] for a run with `flags` (`rosette run --duration`, `--max-steps`).
 pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Result<(SceneConfig, String), PresetError> {
-    let (mut table, file) = read_preset(PresetKind::Scene, spec, None, Some("scene"))?;
+    let (own, file) = read_preset(PresetKind::Scene, spec, None, Some("scene"))?;
+    let (mut table, base_table) = crate::settings::read::with_base(own.clone(), &file)?;
     let base = if looks_like_path(spec) || Path::new(spec).exists() { Path::new(spec).parent().map(Path::to_path_buf) } else { None };
     let scene_fabric_keys = table.get("fabric").and_then(|v| v.as_table()).map(|t| t.keys().cloned().collect()).unwrap_or_default();
     let mut sources = Sources {
@@ -169,7 +172,11 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
     // file is the user's. Each `--set` and flag is the user's.
     let scene_origin = if file.ends_with("(bundled)") || crate::settings::read::is_pattern_spec(spec) { Origin::Bundled } else { Origin::User };
     let mut origins = Origins::default();
-    origins.record_table("", &table, scene_origin);
+    if let Some(base) = &base_table {
+        origins.record_table("", base, Origin::Bundled);
+    }
+    // The base's keys are laid under the scene's: what the scene file gives is its own.
+    origins.record_table("", &own, scene_origin);
     let mut fabric_table = None;
     // The fabric file named in the scene file, for the original values.
     if let Some(name) = table.get("fabric").and_then(|f| f.get("preset")).and_then(|v| v.as_str()) {

@@ -6,7 +6,8 @@ pub mod garment;
 pub mod levels;
 pub mod load;
 pub mod measures;
-pub mod memory;
+/// The memory estimate lives with the checks that use it before any mesh is built.
+pub use crate::settings::validate::memory;
 pub mod possible;
 pub mod props;
 pub mod rigs;
@@ -61,6 +62,9 @@ pub struct Scene {
     pub deadline: Option<std::time::Instant>,
     /// The mesh the model has now; replaced with the model (`Scene::topology`).
     topology: std::sync::Arc<Topology>,
+    /// What the run plan chose over the scene's settings on the scene's own mesh, and the
+    /// user's values it kept (`plan::Choice`).
+    plan_choices: Vec<plan::Choice>,
 }
 
 
@@ -72,6 +76,7 @@ const POOL_STEP_TRIANGLES: usize = 4096;
 impl Scene {
     pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
         let plan = plan::RunPlan::resolve(&config)?;
+        let choices = plan.levels.last().map(|l| l.choices.clone()).unwrap_or_default();
         let mut levels = plan.levels.into_iter();
         let first = levels.next().expect("a plan has at least one level");
         let mut scene = Self::build_level(config.clone(), first)?;
@@ -80,6 +85,7 @@ impl Scene {
             let pending = levels.map(|level| Self::build_level(config.clone(), level)).collect::<Result<_, _>>()?;
             scene.levels = Some(levels::Levels::new(&scene, pending));
         }
+        scene.plan_choices = choices;
         Ok(scene)
     }
 
@@ -104,7 +110,7 @@ impl Scene {
             let (state, model, props) = (State::at_rest(parts.x), parts.model, parts.props);
             let sample_every = (steps / 400).max(1);
             let topology = std::sync::Arc::new(Topology::of(&model));
-            return Ok(Self { state, config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: Some(parts.sewing), deadline: None, topology });
+            return Ok(Self { state, config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: Some(parts.sewing), deadline: None, topology, plan_choices: Vec::new() });
         }
         let c = &level_config.cloth;
         let warp = c.warp_angle_deg.to_radians();
@@ -142,7 +148,7 @@ impl Scene {
         let steps = (config.scene.duration / level_config.solver.dt).ceil().max(1.0) as u64;
         let sample_every = (steps / 400).max(1);
         let topology = std::sync::Arc::new(Topology::of(&model));
-        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: None, deadline: None, topology })
+        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: None, deadline: None, topology, plan_choices: Vec::new() })
     }
 
     /// Changes the time step (s) and integrator, keeping positions, velocities, time and
@@ -155,11 +161,20 @@ impl Scene {
         }
         self.config.solver.dt = dt;
         self.config.solver.integrator = kind;
+        // A step set in the window is the user's: the plan keeps it.
+        self.config.origins.record("solver.dt", crate::settings::Origin::User);
+        self.config.origins.record("solver.integrator", crate::settings::Origin::User);
         let mut integrator = plan::level(&self.config, self.level_edge).solver.integrator();
         integrator.contact_stats = self.integrator.contact_stats;
         self.integrator = integrator;
         self.state.clear_history();
         Ok(())
+    }
+
+    /// What the run plan chose over the scene's settings on the scene's own mesh, and the
+    /// user's values it kept.
+    pub fn plan_choices(&self) -> &[plan::Choice] {
+        &self.plan_choices
     }
 
     /// The cloth's mesh now, with a version that changes whenever the mesh does (a weld, a

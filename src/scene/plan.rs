@@ -16,7 +16,7 @@
 //!              └ a laboratory rig ──────────── Exact (the loading is the experiment)
 //! ```
 
-use crate::settings::SolverPath;
+use crate::settings::{Origin, SolverPath};
 use super::{SceneConfig, SceneError, SceneKind};
 use crate::physics::{bending_length, weight_per_area};
 use crate::sim::PreconditionerChoice;
@@ -73,6 +73,70 @@ pub struct Level {
     /// The scene's settings as this level runs them: the mesh, solver and contact sections
     /// resolved; the model's sections as the scene has them.
     pub config: SceneConfig,
+    /// Every setting the plan chose over the scene's value, and every value of the user's
+    /// it kept where it would have chosen another.
+    pub choices: Vec<Choice>,
+}
+
+/// A setting the plan chose over the value the scene had (a default or a bundled scene's),
+/// or a value the user set that it kept although it would have chosen another.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Choice {
+    /// The dotted key, as a scene file spells it.
+    pub key: &'static str,
+    /// The value the level runs with.
+    pub value: String,
+    /// The scene's value: the one replaced, or the user's one kept.
+    pub scene_value: String,
+    /// Who gave the scene's value: "the default", "the bundled scene" or "yours".
+    pub origin: &'static str,
+    /// The user's value stood, and `plan_value` is what the plan would have taken.
+    pub kept: bool,
+    pub plan_value: String,
+    /// Why the plan takes its value, and what keeping the user's costs.
+    pub why: &'static str,
+}
+
+impl Choice {
+    /// The choice in words, for `--plan`.
+    pub fn describe(&self) -> String {
+        if self.kept {
+            format!("{} = {} (yours; the plan would take {}: {})", self.key, self.value, self.plan_value, self.why)
+        } else {
+            format!("{} = {} (replaces {}'s {}: {})", self.key, self.value, self.origin, self.scene_value, self.why)
+        }
+    }
+}
+
+/// Records the plan's choices for one level: a key the user set keeps their value, any
+/// other takes the plan's.
+struct Chooser<'a> {
+    origins: &'a crate::settings::Origins,
+    choices: Vec<Choice>,
+}
+
+impl Chooser<'_> {
+    /// Sets `slot` (the setting at `key`) to `value` unless the user gave it; records the
+    /// choice either way where the two differ.
+    fn choose<T: PartialEq + Copy>(&mut self, key: &'static str, slot: &mut T, value: T, show: impl Fn(T) -> String, why: &'static str) {
+        if *slot == value {
+            return;
+        }
+        let origin = self.origins.of(key);
+        let kept = origin == Origin::User;
+        self.choices.push(Choice {
+            key,
+            value: show(if kept { *slot } else { value }),
+            scene_value: show(*slot),
+            origin: origin.name(),
+            kept,
+            plan_value: show(value),
+            why,
+        });
+        if !kept {
+            *slot = value;
+        }
+    }
 }
 
 /// How a scene runs: its design and its levels, coarsest first.
@@ -96,7 +160,9 @@ impl RunPlan {
         }
         let own = config.mesh.edge_length;
         let edges = match design {
-            Design::Exact => return Ok(Self { design, levels: vec![Level { edge_length: own, fast: false, config: level(config, None) }] }),
+            Design::Exact => {
+                return Ok(Self { design, levels: vec![Level { edge_length: own, fast: false, config: config.clone(), choices: Vec::new() }] });
+            }
             Design::Motion | Design::Garment => vec![own],
             Design::Settling => {
                 let coarsest = coarsest_edge(config).map_err(crate::sim::ModelError::from)?;
@@ -107,7 +173,13 @@ impl RunPlan {
                 edges
             }
         };
-        let levels = edges.into_iter().map(|edge| Level { edge_length: edge, fast: true, config: level(config, Some(edge)) }).collect();
+        let levels = edges
+            .into_iter()
+            .map(|edge| {
+                let (config, choices) = level_with_choices(config, Some(edge));
+                Level { edge_length: edge, fast: true, config, choices }
+            })
+            .collect();
         Ok(Self { design, levels })
     }
 
@@ -145,6 +217,9 @@ impl RunPlan {
                 if n.recycled_directions > 0 { format!(", CG deflated by the last {} directions", n.recycled_directions) } else { String::new() },
                 if n.cg_max_iterations < crate::sim::NewtonSettings::default().cg_max_iterations { format!(", CG stopped at {} iterations a solve", n.cg_max_iterations) } else { String::new() },
             );
+            for choice in &level.choices {
+                let _ = writeln!(text, "  {}: {}", if choice.kept { "kept" } else { "chosen" }, choice.describe());
+            }
             if !c.props.is_empty() || c.contact.self_collision {
                 let factor = c.contact.stiffness / scene.contact.stiffness;
                 let _ = writeln!(
@@ -205,13 +280,29 @@ fn quasi_static(config: &SceneConfig) -> bool {
 /// contact. Also what a settings change on a running scene re-plans with
 /// (`Scene::set_solver`).
 pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConfig {
+    level_with_choices(config, edge_length).0
+}
+
+/// [`level`], with the choices the plan made over the scene's values and the user's values
+/// it kept.
+fn level_with_choices(config: &SceneConfig, edge_length: Option<f64>) -> (SceneConfig, Vec<Choice>) {
     let mut level = config.clone();
-    let Some(edge) = edge_length else { return level };
+    let Some(edge) = edge_length else { return (level, Vec::new()) };
+    let mut chooser = Chooser { origins: &config.origins, choices: Vec::new() };
     let fast = &config.solver.fast;
     level.mesh.edge_length = edge;
+    let yes_no = |b: bool| b.to_string();
+    let number = |v: f64| crate::io::number::short(v);
+    let count = |v: usize| v.to_string();
     // The pair list is kept across Newton iterations by the cloth's motion relative to its
     // common fall (docs/fast-path.md, item 3).
-    level.contact.relative_motion = true;
+    chooser.choose(
+        "contact.relative_motion",
+        &mut level.contact.relative_motion,
+        true,
+        yes_no,
+        "the pair list follows the cloth's motion relative to its common fall (docs/fast-path.md, item 3)",
+    );
     // Long steps follow a quasi-static load through near-equilibria, which holds where
     // the mesh resolves the folds. On a mesh whose elements are as wide as the folds the
     // drape depends on the path at the scale of an element, and the scene keeps its step.
@@ -232,41 +323,94 @@ pub(super) fn level(config: &SceneConfig, edge_length: Option<f64>) -> SceneConf
         (false, _) => Some(fast.drop_dt),
     };
     if let Some(long_dt) = long_dt.filter(|&d| d > config.solver.dt) {
-        level.solver.dt = long_dt;
+        let why_dt = match (slow, kind) {
+            (true, _) => "the fast path's long step for a slowly loaded cloth on a mesh that resolves its folds (solver.fast.dt)",
+            (false, Design::Garment) => "the fast path's step for a garment (solver.fast.garment_dt)",
+            (false, _) => "the fast path's step for a cloth dropped onto props (solver.fast.drop_dt)",
+        };
+        chooser.choose("solver.dt", &mut level.solver.dt, long_dt, number, why_dt);
         if !slow {
-            level.contact.stiffness *= (long_dt / config.solver.dt).powi(2);
+            // The penalty's stiffness c·m/Δt² stays the scene's at the longer step.
+            let scaled = config.contact.stiffness * (level.solver.dt / config.solver.dt).powi(2);
+            chooser.choose(
+                "contact.stiffness",
+                &mut level.contact.stiffness,
+                scaled,
+                number,
+                "scaled with the square of the step, so that the contact layer is as stiff as at the scene's step",
+            );
         }
         // The first step after a transfer relaxes, in one long step, what the coarser
         // mesh could not resolve; Newton gets the iterations that takes.
-        level.solver.newton.max_iterations = level.solver.newton.max_iterations.max(FAST_MAX_ITERATIONS);
+        let iterations = level.solver.newton.max_iterations.max(FAST_MAX_ITERATIONS);
+        chooser.choose(
+            "solver.newton.max_iterations",
+            &mut level.solver.newton.max_iterations,
+            iterations,
+            count,
+            "a long step relaxes in one step what a coarser level or the last step left",
+        );
         // On a slowly loaded drape at long steps the incomplete factor leaves CG tens of
         // iterations per Newton iteration; the complete factor a few, and it is rebuilt
         // rarely. A falling cloth's contacts and shifts change from one iteration to the
         // next, and rebuilding the complete factor that often costs more than the
         // incomplete factor's extra CG iterations (docs/fast-path.md), at any size.
-        if level.solver.newton.preconditioner == PreconditionerChoice::Auto {
-            level.solver.newton.preconditioner = if slow { PreconditionerChoice::Cholesky } else { PreconditionerChoice::IncompleteCholesky };
+        // A preconditioner a bundled scene names is its own choice, as the default `auto`
+        // is the plan's to make; the user's stands, with a word where the plan differs.
+        if level.solver.newton.preconditioner == PreconditionerChoice::Auto || config.origins.by_user("solver.newton.preconditioner") {
+            let factor = if slow { PreconditionerChoice::Cholesky } else { PreconditionerChoice::IncompleteCholesky };
+            chooser.choose(
+                "solver.newton.preconditioner",
+                &mut level.solver.newton.preconditioner,
+                factor,
+                |p| key_name(&p),
+                "the complete factor serves a slowly loaded drape's long steps; a moving cloth's matrix changes too often for it",
+            );
         }
     }
     // Garments keep the tighter share: at the motion's, the shift dress settled on 3 hem
     // nodes instead of the exact path's 5 and the circle skirt did not settle in 6 s
     // (docs/performance-log.md).
-    level.solver.newton.error_share = if kind == Design::Motion { fast.motion_error_share } else { fast.error_share };
+    let (share, why_share) = if kind == Design::Motion {
+        (fast.motion_error_share, "Newton stops at a share of the step's own error for cloth in motion (solver.fast.motion_error_share)")
+    } else {
+        (fast.error_share, "Newton stops at a share of the step's own error (solver.fast.error_share)")
+    };
+    chooser.choose("solver.newton.error_share", &mut level.solver.newton.error_share, share, number, why_share);
     // A garment coming to rest repeats its slow swing from step to step: its solves are
     // deflated by the last Newton directions (docs/fast-path.md, item 7). A few of its
     // solves run to thousands of CG iterations even on a fresh factor: they stop at the
     // fast path's limit, and Newton goes on with a fresh factor (item 8).
     if kind == Design::Garment {
-        level.solver.newton.recycled_directions = fast.recycled_directions;
-        level.solver.newton.cg_max_iterations = level.solver.newton.cg_max_iterations.min(fast.cg_max_iterations);
+        chooser.choose(
+            "solver.newton.recycled_directions",
+            &mut level.solver.newton.recycled_directions,
+            fast.recycled_directions,
+            count,
+            "a garment coming to rest repeats its slow swing: its solves are deflated by the last directions (solver.fast.recycled_directions)",
+        );
+        let limit = level.solver.newton.cg_max_iterations.min(fast.cg_max_iterations);
+        chooser.choose(
+            "solver.newton.cg_max_iterations",
+            &mut level.solver.newton.cg_max_iterations,
+            limit,
+            count,
+            "a garment's rare solves of thousands of CG iterations stop there and Newton goes on with a fresh factor (solver.fast.cg_max_iterations)",
+        );
     }
     // A cloth landing on a prop buckles in most iterations of its landing steps: once
     // the exact matrix has failed in a step, the rest of the step is solved on the
     // bounded one instead of trying the exact one first again (docs/fast-path.md).
     if !slow {
-        level.solver.newton.retry_exact = false;
+        chooser.choose(
+            "solver.newton.retry_exact",
+            &mut level.solver.newton.retry_exact,
+            false,
+            yes_no,
+            "a landing cloth buckles in most iterations: once the exact matrix fails in a step, the rest of the step takes the bounded one",
+        );
     }
-    level
+    (level, chooser.choices)
 }
 
 #[cfg(test)]
@@ -355,6 +499,44 @@ mod tests {
         assert_eq!(config.solver.newton.recycled_directions, 0);
         let (_, drape) = super::tests::plan("cusick-drape", &["solver.path=fast"]);
         assert!(drape.levels.iter().all(|l| l.config.solver.newton.recycled_directions == 0));
+    }
+
+    /// What the user set stands: for every key the fast path's plan may change, a value set
+    /// with `--set` is the one the scene's own mesh runs with, and the plan says it kept it
+    /// and what it would have taken; left to the default or the bundled scene, the plan's
+    /// value runs and the plan says what it replaced.
+    #[test]
+    fn every_key_the_plan_changes_stands_where_the_user_set_it() {
+        // (scene, key, a value of the user's unlike the plan's, how the level holds it)
+        type Read = fn(&SceneConfig) -> String;
+        let cases: [(&str, &str, &str, Read); 9] = [
+            ("tablecloth", "contact.relative_motion", "false", |c| c.contact.relative_motion.to_string()),
+            ("tablecloth", "solver.dt", "0.008", |c| c.solver.dt.to_string()),
+            ("tablecloth", "contact.stiffness", "250", |c| c.contact.stiffness.to_string()),
+            ("tablecloth", "solver.newton.max_iterations", "2", |c| c.solver.newton.max_iterations.to_string()),
+            ("tablecloth", "solver.newton.preconditioner", "\"cholesky\"", |c| format!("\"{}\"", key_name(&c.solver.newton.preconditioner))),
+            ("tablecloth", "solver.newton.error_share", "0.02", |c| c.solver.newton.error_share.to_string()),
+            ("skirt-gored-bias", "solver.newton.recycled_directions", "2", |c| c.solver.newton.recycled_directions.to_string()),
+            ("skirt-gored-bias", "solver.newton.cg_max_iterations", "2500", |c| c.solver.newton.cg_max_iterations.to_string()),
+            ("tablecloth", "solver.newton.retry_exact", "true", |c| c.solver.newton.retry_exact.to_string()),
+        ];
+        for (scene, key, value, read) in cases {
+            let (default_config, default_plan) = plan(scene, &["solver.path=fast"]);
+            let level = default_plan.levels.last().unwrap();
+            let chosen = level.choices.iter().find(|c| c.key == key).unwrap_or_else(|| panic!("{scene}: the plan changes {key}"));
+            assert!(!chosen.kept);
+            assert_eq!(chosen.value, read(&level.config).trim_matches('"'), "{key}: the value run is the one printed");
+            assert_ne!(chosen.scene_value, chosen.value);
+            let described = default_plan.describe(&default_config);
+            assert!(described.contains(&format!("chosen: {key} = {}", chosen.value)) && described.contains("replaces"), "{described}");
+            let (config, user_plan) = plan(scene, &["solver.path=fast", &format!("{key}={value}")]);
+            let level = user_plan.levels.last().unwrap();
+            assert_eq!(read(&level.config), value, "{scene}: {key} set by the user stands");
+            let kept = level.choices.iter().find(|c| c.key == key).unwrap_or_else(|| panic!("{scene}: {key} kept without a word"));
+            // The plan's own value (the stiffness it would scale from the user's own).
+            assert!(kept.kept && kept.origin == "yours" && kept.value == value.trim_matches('"') && kept.plan_value != kept.value, "{kept:?}");
+            assert!(user_plan.describe(&config).contains(&format!("kept: {key} = ")), "{}", user_plan.describe(&config));
+        }
     }
 
     #[test]

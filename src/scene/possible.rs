@@ -134,6 +134,12 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
             ));
             d.drape_coefficient = f64::NAN;
         }
+        Measures::Garment(g) if g.sewn => {
+            if let Some(reason) = off_form(scene) {
+                metrics.notes.push(format!("garment measures withheld: {reason}"));
+                g.withhold(reason);
+            }
+        }
         Measures::Shear(s) => {
             let seed = config.test.perturbation.unwrap_or(0.0);
             if s.wrinkle_amplitude <= WRINKLE_OVER_SEED * seed && s.wrinkle_count > 0 {
@@ -186,6 +192,46 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
             short(duration)
         ));
     }
+}
+
+/// How far the garment's top may end under the height it is held at before it has slid
+/// off its form, m (a skirt settles a few centimetres at most), and how deep inside the
+/// form, in contact layers, a garment may end before it is not on the form but in it.
+const SLIP: f64 = 0.1;
+const INSIDE_LAYERS: f64 = 3.0;
+
+/// Why a sewn garment is not hanging on its form, if it is not: fallen below the floor,
+/// slid down from where it is held, or ended inside the form deeper than its contact
+/// layer allows. A garment's measures are those of a garment on its form; anything else
+/// is said, not measured.
+pub fn off_form(scene: &Scene) -> Option<String> {
+    let super::Rig::Garment(rig) = &scene.rig else { return None };
+    let x = &scene.state.x;
+    let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.z), hi.max(p.z)));
+    let layer = scene.config.contact.thickness;
+    if low < -(2.0 * layer).max(0.01) {
+        return Some(format!("the garment fell off its form: its lowest point ends {} m below the floor", short(-low)));
+    }
+    let held = rig.support_height();
+    if high < held - SLIP {
+        return Some(format!(
+            "the garment slid off its form: its top ends {} cm under the height it is held at ({} m); a pattern wider than the form \
+             where it is held (the waist or the hips) slides down: take it in, or hold it there ([[garment.attachments]])",
+            short(100.0 * (held - high)),
+            short(held)
+        ));
+    }
+    let form = scene.props.first()?;
+    let deepest = x.iter().map(|&p| -form.surface_point(p).distance).fold(0.0, f64::max);
+    (deepest > INSIDE_LAYERS * layer).then(|| {
+        format!(
+            "the garment ends {} mm inside its form, {} times its contact layer (contact.thickness = {} mm): the form does not \
+             hold it; thicken the layer or shorten the step (solver.dt)",
+            short(1e3 * deepest),
+            short(deepest / layer),
+            short(1e3 * layer)
+        )
+    })
 }
 
 #[cfg(test)]

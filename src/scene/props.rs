@@ -79,6 +79,20 @@ pub fn obj_path(file: &str, base_dir: Option<&Path>) -> PathBuf {
     }
 }
 
+/// Every file a scene names that is read only when the scene is built (the props' meshes,
+/// the garment form's body), on disk, for the output guard to know before the run: the
+/// one list of a scene's later inputs. Bundled assets are not files.
+pub fn files_named(config: &crate::settings::SceneConfig) -> Vec<(PathBuf, FileKind)> {
+    let base = config.base_dir.as_deref();
+    let props = config.props.iter().filter_map(|p| p.file.as_deref());
+    let form = config.garment.as_ref().and_then(|g| g.form.obj.as_deref());
+    props
+        .chain(form)
+        .filter(|file| !ASSETS.iter().any(|a| a.name == *file))
+        .map(|file| (obj_path(file, base), FileKind::Obj))
+        .collect()
+}
+
 /// Checks every vertex line (`v x y z`) before the OBJ reader sees it, so that a bad
 /// coordinate is named by its line: the reader takes `nan`, `inf` and numbers past f32's
 /// range (1e39) without complaint, and such a prop would silently drop out of contact.

@@ -85,6 +85,18 @@ pub struct Metrics {
     /// (`possible::judge`): a measure left out of `measures` is explained here.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// Every setting the run plan chose over the scene's value, and every value of the
+    /// user's it kept although it would have chosen another, on the scene's own mesh
+    /// (`plan::Choice`; `rosette run --plan` prints them per level).
+    #[serde(default, skip_serializing_if = "Vec::is_empty", deserialize_with = "plan_choices")]
+    pub plan_overrides: Vec<super::plan::Choice>,
+}
+
+/// Reads `Metrics::plan_overrides` back as their sentences are not needed by a reader:
+/// each entry is kept whole as written.
+fn plan_choices<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<super::plan::Choice>, D::Error> {
+    let _ = Vec::<serde_json::Value>::deserialize(deserializer)?;
+    Ok(Vec::new())
 }
 
 /// What the contact handling had to do over a run (`Metrics::contact_events`).
@@ -292,6 +304,10 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
             stopped_at_limit = Some(format!("stopped after {limit} s of wall time, the bound --max-wall (raise it)"));
             break;
         }
+        if let Some(signal) = crate::io::interrupt::received() {
+            stopped_at_limit = Some(format!("stopped by {} after {k} steps", crate::io::interrupt::name(signal)));
+            break;
+        }
         k += 1;
         let report = match scene.step() {
             Ok(report) => report,
@@ -358,6 +374,7 @@ pub fn run_scene(scene: &mut Scene, name: &str, options: RunOptions) -> (Metrics
         step_time: tally.step_time,
         measures: scene.measures(),
         notes: Vec::new(),
+        plan_overrides: scene.plan_choices().to_vec(),
     };
     super::possible::judge(scene, &mut metrics, duration);
     (metrics, error)

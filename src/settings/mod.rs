@@ -21,7 +21,7 @@ pub mod validate;
 pub use fabric::FabricConfig;
 pub use origin::{Origin, Origins};
 pub use read::{PresetError, PresetKind, parse_override, read_preset, scene_descriptions};
-pub use registry::{ASSETS, Asset, Bundled, FABRICS, SCENES};
+pub use registry::{ASSETS, Asset, BASES, Bundled, FABRICS, SCENES};
 pub use schema::{
     ClothSection, DEFAULT_MAX_STEPS, FastSettings, MeshSection, PhysicsSection, PropConfig, PropKind, SceneConfig, SceneKind, SceneSection,
     ShearKinematics, SolverPath, SolverSection, TestSection,

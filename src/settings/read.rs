@@ -37,6 +37,37 @@ pub fn is_pattern_spec(spec: &str) -> bool {
     is_arcsim_file(spec)
 }
 
+/// A scene table with the bundled base it names (`base = "garment"`) laid under it: the
+/// base's keys, then the scene's over them (tables merged key by key, any other value
+/// replaced). Returns the merged table and the base's own table; a scene without `base` is
+/// returned as it is.
+pub fn with_base(mut table: toml::Table, file: &str) -> Result<(toml::Table, Option<toml::Table>), PresetError> {
+    let Some(base) = table.remove("base") else { return Ok((table, None)) };
+    let names = || super::registry::BASES.iter().map(|b| format!("\"{}\"", b.name)).collect::<Vec<_>>().join(", ");
+    let invalid = |message: String| PresetError::Invalid { file: file.to_string(), message };
+    let name = base.as_str().ok_or_else(|| invalid(format!("base must name bundled settings in quotes ({}), got {base}", names())))?;
+    let bundled = super::registry::BASES
+        .iter()
+        .find(|b| b.name == name)
+        .ok_or_else(|| invalid(format!("base = \"{name}\": no bundled settings of that name; the bases are {}", names())))?;
+    let base = parse_table(bundled.text, &format!("presets/bases/{name}.toml (bundled)"))?;
+    let mut merged = base.clone();
+    lay_over(&mut merged, table);
+    Ok((merged, Some(base)))
+}
+
+/// Lays `over`'s keys over `under`: tables merged key by key, other values replaced.
+fn lay_over(under: &mut toml::Table, over: toml::Table) {
+    for (key, value) in over {
+        match (under.get_mut(&key), value) {
+            (Some(toml::Value::Table(below)), toml::Value::Table(above)) => lay_over(below, above),
+            (_, value) => {
+                under.insert(key, value);
+            }
+        }
+    }
+}
+
 /// What a name or a path stands for: a scene or a fabric.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PresetKind {

@@ -19,6 +19,10 @@ pub const SCENES: &[Bundled] = bundled!("";
     "cusick-drape", "cusick-drape-30", "tablecloth", "sphere-drop",
     "skirt-circle", "skirt-gored-straight", "skirt-gored-bias", "shift-dress", "swing");
 
+/// Bundled base settings a scene file names with `base = "NAME"` and lays its own keys
+/// over: the settings a kind of scene shares, written once.
+pub const BASES: &[Bundled] = bundled!("bases/"; "garment");
+
 /// Bundled fabrics.
 pub const FABRICS: &[Bundled] = bundled!("fabrics/"; "wool", "cotton-shirting", "denim", "polyester", "silk", "wool-plain-fast", "wool-worsted", "wool-flannel", "cotton-poplin", "cotton-oxford", "cotton-lawn", "denim-14oz", "11oz-black-denim", "royal-target", "white-dots-on-blk", "pink-ribbon-brown");
 

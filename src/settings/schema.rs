@@ -341,20 +341,11 @@ impl SolverPath {
 pub struct FastSettings {
     /// Time step of the levels that resolve the folds of a slowly loaded cloth, s.
     pub dt: f64,
-    /// Time step of a cloth dropped onto props, s: shorter than `dt`, since the folds a
-    /// falling cloth lands in depend on the fall's path, which long steps damp and change
-    /// (docs/fast-path.md: with every Newton solve converged the tablecloth's coefficient
-    /// came out 0.23–0.26 at 32 ms against the exact path's 0.066–0.146 over eight seeds,
-    /// and 0.129–0.141 at 16 ms over seeds 1–3).
+    /// Time step of a cloth dropped onto props, s: shorter than `dt`, since long steps damp
+    /// and change the fall's path, and with it the folds it lands in (docs/fast-path.md).
     pub drop_dt: f64,
-    /// Time step of a garment, s: its panels are lowered by the gravity ramp and drawn
-    /// together by the sewing, and it then hangs on its form, held by friction and its own
-    /// seams. Measured against the exact path on the four bundled garments and on two in
-    /// other fabrics (docs/performance-log.md): at 24 ms every one settled with its hem
-    /// heights within 2 mm, drape coefficients within 0.008 and node counts as close as at
-    /// the drop's 16 ms (closer on silk), and the 10k-triangle circle skirt settled in
-    /// 57–71 s over three runs against 70 s at 16 ms; at 32 ms the shift dress had not
-    /// settled when its 6 s ran out.
+    /// Time step of a garment, s: the longest at which every measured garment settled with
+    /// its hem and drape coefficient as at the drop's step (docs/fast-path.md).
     pub garment_dt: f64,
     /// Largest edge of the coarsest level as a share of the fabric's bending length
     /// (B/w)^(1/3): coarse enough to be cheap, fine enough that folds, whose width scales
@@ -363,22 +354,14 @@ pub struct FastSettings {
     /// Newton stops at a step under this share of the step's own integration error
     /// (`solver.newton.error_share`; the exact path's tolerance still holds at rest).
     pub error_share: f64,
-    /// The same share for cloth in motion (drops not watched for settling, the swing): a
-    /// third of the step's own error halves Newton's iterations on the peers' sphere scene
-    /// and leaves the swing's period unchanged to 2e-5, while vertices may sink up to 0.8
-    /// of the contact layer where 0.1 let none in (docs/fast-path.md, item 6).
+    /// The same share for cloth in motion (drops not watched for settling, the swing),
+    /// where it halves Newton's iterations (docs/fast-path.md, item 6).
     pub motion_error_share: f64,
-    /// How many of the last Newton directions deflate a garment's CG solves on meshes whose
-    /// incomplete factor is split (`solver.newton.recycled_directions`): a garment coming
-    /// to rest on its form repeats its slow swing from step to step, and the split factor
-    /// resolved it in 100–190 CG iterations a solve near the end (docs/performance-log.md,
-    /// "2026-12-05").
+    /// How many of the last Newton directions deflate a garment's CG solves where its
+    /// incomplete factor is split (`solver.newton.recycled_directions`; docs/fast-path.md).
     pub recycled_directions: usize,
     /// The most CG iterations a garment's linear solve takes (`solver.newton.cg_max_iterations`,
-    /// where that is lower it holds): a solve stopped there hands Newton the direction it has,
-    /// its next iteration takes a fresh factor, and Newton cannot stop on it. A few solves of
-    /// a 10k garment's fall ran to 500–2 000 iterations on a fresh factor, each as costly as
-    /// tens of Newton iterations (docs/performance-log.md, "2026-12-06, thirteenth sitting").
+    /// where that is lower it holds); docs/fast-path.md says why.
     pub cg_max_iterations: usize,
 }
 

@@ -87,6 +87,8 @@ pub enum FabricError {
          segments of the curves"
     )]
     PoissonTooLarge { nu: f64, limit: f64 },
+    #[error("fabric.{key} = {value:e} is below any fabric (at least {min:e} {unit}: {why}): check the units")]
+    TooSmall { key: &'static str, value: f64, min: f64, unit: &'static str, why: &'static str },
     #[error("fabric.{key} = {value:e} is beyond any fabric (at most {max:e} in SI units; a 1 cm steel plate stays below it): check the units")]
     TooLarge { key: &'static str, value: f64, max: f64 },
     #[error(
@@ -105,7 +107,11 @@ impl FabricError {
     /// The fabric key the error is about (the key under `fabric.`).
     pub fn key(&self) -> &'static str {
         match self {
-            Self::OutOfRange { key, .. } | Self::Curve { key, .. } | Self::TooLarge { key, .. } | Self::SteepCurve { key, .. } => key,
+            Self::OutOfRange { key, .. }
+            | Self::Curve { key, .. }
+            | Self::TooLarge { key, .. }
+            | Self::TooSmall { key, .. }
+            | Self::SteepCurve { key, .. } => key,
             Self::PoissonTooLarge { .. } => "poisson_warp",
             Self::BiasTooSmall { .. } => "bending_bias",
         }
@@ -123,6 +129,18 @@ const MIN_AREAL_DENSITY: f64 = 1e-3;
 const MAX_THICKNESS: f64 = 0.1;
 const MAX_MODULUS: f64 = 1e11;
 const MAX_RIGIDITY: f64 = 1e6;
+/// Floors far below any fabric, which refuse a value that underflows to nothing (5e-324)
+/// instead of letting it reach the metrics as a zero or a NaN: the thinnest chiffon is
+/// about 0.05 mm thick, bends with about 5e-7 N·m and shears with about 10 N/m
+/// (KES-F B ≈ 0.005 gf·cm and G ≈ 0.2 gf/cm/° for light silks; docs/robustness.md).
+const MIN_THICKNESS: f64 = 1e-6;
+const MIN_MODULUS: f64 = 1e-3;
+const MIN_RIGIDITY: f64 = 1e-9;
+
+/// Refuses `value` below `min` (after [`in_range`] has checked it is positive and finite).
+fn at_least(key: &'static str, value: f64, min: f64, unit: &'static str, why: &'static str) -> Result<(), FabricError> {
+    if value < min { Err(FabricError::TooSmall { key, value, min, unit, why }) } else { Ok(()) }
+}
 
 fn in_range(key: &'static str, value: f64, max: f64) -> Result<(), FabricError> {
     if !(value.is_finite() && value > 0.0) {
@@ -156,6 +174,14 @@ impl Fabric {
         in_range("shear_modulus", self.shear_modulus, MAX_MODULUS)?;
         in_range("bending_warp", self.bending_warp, MAX_RIGIDITY)?;
         in_range("bending_weft", self.bending_weft, MAX_RIGIDITY)?;
+        at_least("thickness", self.thickness, MIN_THICKNESS, "m", "a thousandth of a millimetre; the thinnest fabrics are 0.05 mm")?;
+        at_least("shear_modulus", self.shear_modulus, MIN_MODULUS, "N/m", "the softest fabrics shear with about 10 N/m")?;
+        for (key, value) in [("bending_warp", self.bending_warp), ("bending_weft", self.bending_weft)] {
+            at_least(key, value, MIN_RIGIDITY, "N·m", "the softest fabrics bend with about 5e-7 N·m")?;
+        }
+        for (key, curve) in [("tensile_warp", &self.tensile_warp), ("tensile_weft", &self.tensile_weft)] {
+            at_least(key, curve.max_slope(), MIN_MODULUS, "N/m, its steepest segment", "fabrics stretch with hundreds of N/m or more")?;
+        }
         if !(0.0..0.5).contains(&self.poisson_warp) {
             return Err(FabricError::OutOfRange {
                 key: "poisson_warp",

@@ -144,6 +144,20 @@ pub fn from_fields(
             ));
         }
     }
+    // The rest plate must resist a pull along each axis: C11·C22 > C12² (with C12 clamped
+    // at zero as ARCSim does), or the uniaxial stiffness E = C11 − C12²/C22 is zero or less.
+    let [c11, c12, c22, _] = stretching[0];
+    if c12.max(0.0).powi(2) >= c11 * c22 {
+        return Err(field_error(
+            file,
+            format!("{}[0][1]", name("stretching")),
+            format!(
+                "c12 = {c12} at zero strain is at least √(c11·c22) = {:.4}: the sheet would have no stiffness under a \
+                 pull along u or v (c11 − c12²/c22 ≤ 0); c12 must be smaller than √(c11·c22)",
+                (c11 * c22).sqrt()
+            ),
+        ));
+    }
     for (i, row) in bending.iter().enumerate() {
         for (j, &v) in row.iter().enumerate() {
             if v <= 0.0 {
@@ -303,6 +317,9 @@ mod tests {
         assert!(e.contains("bending") && e.contains("has 2 rows"), "{e}");
         let e = err(&DENIM.replace("205.352005", "-205.352005"));
         assert!(e.contains("stretching[0][0]") && e.contains("positive"), "{e}");
+        // c12 above √(c11·c22) = 456.3: no stiffness under a uniaxial pull at rest.
+        let e = err(&DENIM.replace("10.234077", "500.0"));
+        assert!(e.contains("stretching[0][1]") && e.contains("√(c11·c22)"), "{e}");
         let e = err("/* open");
         assert!(e.contains("not closed") && e.contains("line 1"), "{e}");
         let e = err("[1, 2]");

@@ -72,21 +72,29 @@ pub fn sample(f: &dyn Fn(f64) -> f64, slope: f64, breaks: &[f64]) -> Vec<[f64; 2
     }
     let mut points = vec![[0.0, 0.0], [x1, slope * x1]];
     let mut a = points[1];
+    let mut budget = MAX_KNOTS;
     for &b in breaks {
         let end = [b, f(b)];
-        bisect(f, a, end, &mut points, 0);
+        bisect(f, a, end, &mut points, &mut budget);
         a = end;
     }
     points
 }
 
-fn bisect(f: &dyn Fn(f64) -> f64, a: [f64; 2], b: [f64; 2], points: &mut Vec<[f64; 2]>, depth: usize) {
+/// The most knots a sampled curve gets: a smooth ARCSim pull needs a few dozen; a material
+/// whose load is flat or tiny (a relative tolerance never met) stops here instead of
+/// splitting for ever.
+const MAX_KNOTS: usize = 256;
+
+/// Splits [a, b] where the chord strays from `f`, depth first, while `budget` knots remain.
+fn bisect(f: &dyn Fn(f64) -> f64, a: [f64; 2], b: [f64; 2], points: &mut Vec<[f64; 2]>, budget: &mut usize) {
     let mid = 0.5 * (a[0] + b[0]);
     let (chord, exact) = (0.5 * (a[1] + b[1]), f(mid));
-    if depth < 40 && (chord - exact).abs() > CURVE_TOLERANCE * exact.abs() {
+    if *budget > 0 && mid > a[0] && mid < b[0] && (chord - exact).abs() > CURVE_TOLERANCE * exact.abs() {
+        *budget -= 1;
         let m = [mid, exact];
-        bisect(f, a, m, points, depth + 1);
-        bisect(f, m, b, points, depth + 1);
+        bisect(f, a, m, points, budget);
+        bisect(f, m, b, points, budget);
     } else {
         points.push(b);
     }
@@ -279,4 +287,21 @@ pub fn derive(m: &ArcsimMaterial, origin: &str, explicit: &toml::Table) -> Impor
     }
     out.warnings = warnings;
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A load that no relative tolerance can follow (zero at the knots, tiny between them,
+    /// or flat) is sampled with a bounded number of knots instead of splitting for ever.
+    #[test]
+    fn sampling_is_bounded_whatever_the_load() {
+        let wild = |e: f64| if (e * 1e6).round() as i64 % 2 == 0 { 0.0 } else { 5e-324 };
+        for (f, slope) in [(&wild as &dyn Fn(f64) -> f64, 0.0), (&|_: f64| 0.0, 0.0), (&|e: f64| (1e3 * e).sin(), 1e3)] {
+            let points = sample(f, slope, &[STRAIN_SAMPLE, MAX_STRAIN]);
+            assert!(points.len() <= MAX_KNOTS + 4, "{} knots", points.len());
+            assert!(points.windows(2).all(|w| w[1][0] > w[0][0]), "knots increase");
+        }
+    }
 }

@@ -211,6 +211,10 @@ fn check_uncrossed(garment: &Garment, model: &Model) -> Result<(), SceneError> {
     )))
 }
 
+/// How much farther apart on the flat pattern than self-collision's layer two points of one
+/// panel must be cut for their closeness in space to be a fold.
+const FOLD_SPAN: f64 = 3.0;
+
 /// Refuses panels placed within the layer self-collision keeps between cloth layers
 /// (`reach`, m) of each other, or a panel folded onto itself, leaving out the pairs that
 /// the sewing must bring together: the layer's penalty would throw them apart in the first
@@ -219,7 +223,19 @@ fn check_uncrossed(garment: &Garment, model: &Model) -> Result<(), SceneError> {
 /// self-collision on).
 fn check_apart(garment: &Garment, model: &Model, reach: f64) -> Result<(), SceneError> {
     let panel_of = |v: u32| garment.offsets.partition_point(|&o| o <= v) - 1;
-    let close = crate::sim::contact::pairs_within(&garment.positions, model.cloth(), reach);
+    // Within one panel, a pair is folded only where the cloth between them is longer than
+    // the gap: neighbours on the flat pattern (small triangles along a hem drawn as many
+    // short segments) are close because they are cut close.
+    let flat = |p: DVec2| DVec3::new(p.x, p.y, 0.0);
+    let cut_apart = |v: u32, t: u32| {
+        let pattern = &garment.surface.pattern;
+        let c = model.triangles[t as usize].map(|i| flat(pattern[i as usize]));
+        let p = flat(pattern[v as usize]);
+        let (closest, _) = crate::sim::contact::geometry::closest_point_triangle(p, c[0], c[1], c[2]);
+        closest.distance(p) > FOLD_SPAN * reach
+    };
+    let mut close = crate::sim::contact::pairs_within(&garment.positions, model.cloth(), reach);
+    close.retain(|&(v, t, _)| panel_of(v) != panel_of(model.triangles[t as usize][0]) || cut_apart(v, t));
     let Some(&(v, t, gap)) = close.iter().min_by(|a, b| a.2.total_cmp(&b.2)) else { return Ok(()) };
     let (a, b) = (panel_of(v), panel_of(model.triangles[t as usize][0]));
     let (a, b) = (a.min(b), a.max(b));

@@ -48,12 +48,38 @@ pub struct GarmentMeasures {
     pub shadow_area: f64,
     /// Area of the form's section the drape coefficient is taken against, m².
     pub waist_area: f64,
+    /// Why the garment is not hanging on its form (slid off, fallen, inside it), where it
+    /// is not: its drape measures are then withheld (null).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub off_form: Option<String>,
+}
+
+impl GarmentMeasures {
+    /// Withholds the measures of a garment hanging on its form, saying why (`reason`).
+    pub fn withhold(&mut self, reason: String) {
+        for value in [
+            &mut self.garment_drape_coefficient,
+            &mut self.hem_height_max,
+            &mut self.hem_height_mean,
+            &mut self.hem_height_min,
+            &mut self.hem_height_spread,
+            &mut self.hem_radius_max,
+            &mut self.hem_radius_min,
+            &mut self.shadow_area,
+        ] {
+            *value = f64::NAN;
+        }
+        self.hem_nodes = 0;
+        self.off_form = Some(reason);
+    }
 }
 
 pub struct GarmentRig {
     centre: DVec2,
     /// The support section as a polygon (its points at its height), m.
     waist: Vec<DVec3>,
+    /// The height the garment is held at, m.
+    held_at: f64,
     waist_area: f64,
     pattern_area: f64,
     prominence: f64,
@@ -85,6 +111,7 @@ impl GarmentRig {
         let prominence = 0.03 * (reach(pattern_area + waist_area) - reach(waist_area)).max(config.mesh.edge_length);
         Self {
             centre,
+            held_at: z,
             waist,
             waist_area,
             pattern_area,
@@ -149,7 +176,14 @@ impl GarmentRig {
             sewn_at: self.sewn_at,
             shadow_area: shadow.area,
             waist_area: self.waist_area,
+            off_form: None,
         }
+    }
+
+    /// The height the garment is held at on its form (its attached edges', the form's
+    /// waist, or its top as placed), m.
+    pub fn support_height(&self) -> f64 {
+        self.held_at
     }
 
     /// The shadow's outline around the form's axis, (angle rad, radius m).

@@ -3,6 +3,7 @@
 use super::{Invalid, invalid, non_negative, positive, positive_at_most};
 use crate::garment;
 use crate::settings::SceneConfig;
+use crate::sim::mesh::MAX_VERTICES;
 use glam::DVec2;
 
 /// The stiffest sewing spring a scene may ask for, N/m.
@@ -55,6 +56,7 @@ pub fn check(c: &SceneConfig) -> Result<f64, Invalid> {
     let measurements = g.form.measurements(g.units).map_err(|e| invalid("garment.form", e.to_string()))?;
     let level = |name: &str| measurements.as_ref()?.level(name);
     let metres = g.units.metres();
+    check_size(c, g, h)?;
     let garment = garment::build(g, h, DVec2::from_array(g.form.axis) * metres, &level).map_err(|e| invalid("garment", e.to_string()))?;
     let extent = garment
         .meshes
@@ -70,3 +72,30 @@ pub fn check(c: &SceneConfig) -> Result<f64, Invalid> {
     Ok(extent)
 }
 
+
+/// Refuses, before any panel is meshed, a pattern whose mesh at edge length `h` would pass
+/// the vertex cap or the memory this run has: the count is estimated from the outlines'
+/// areas (an equilateral mesh has 2/(√3·h²) vertices per square metre) and perimeters.
+fn check_size(c: &SceneConfig, g: &garment::GarmentConfig, h: f64) -> Result<(), Invalid> {
+    let metres = g.units.metres();
+    let (mut area, mut perimeter) = (0.0, 0.0);
+    for panel in &g.panels {
+        let Ok(curves) = panel.curves(metres) else { continue };
+        let points = curves.iter().flat_map(|c| c.points.windows(2));
+        area += points.clone().map(|w| 0.5 * w[0].perp_dot(w[1])).sum::<f64>().abs();
+        perimeter += curves.iter().map(|c| c.length()).sum::<f64>();
+    }
+    let planned = |h: f64| 2.0 * area / (3f64.sqrt() * h * h) + perimeter / h;
+    let vertices = planned(h);
+    if vertices > MAX_VERTICES as f64 {
+        let least = 1.001 * h * (vertices / MAX_VERTICES as f64).sqrt();
+        return Err(invalid(
+            "mesh.edge_length",
+            format!("mesh.edge_length = {h} m gives about {vertices:.3e} vertices over the panels' {area:.2} m², more than the limit of {MAX_VERTICES}; use at least {least:.3e} m"),
+        ));
+    }
+    if let Some(available) = super::memory::available_bytes() {
+        super::memory::check(vertices as usize, h, c.solver.newton.preconditioner, available).map_err(|e| invalid("mesh.edge_length", e))?;
+    }
+    Ok(())
+}

@@ -7,6 +7,7 @@
 //! support larger than the specimen), never merely because it is unusual.
 
 mod garment;
+pub mod memory;
 mod motion;
 
 pub use garment::MAX_SEWING_STIFFNESS;

@@ -156,7 +156,7 @@ fn bands_checksum(cloth: Cloth) -> u64 {
 /// narrows what the step's filter examines), contact took 2.92, 2.05, 1.90 and 1.81 s on
 /// the 20k drape; 2.24, 1.81, 1.79 and 1.65 s on the tablecloth; on the sphere drop's first
 /// 0.4 s (one thread) 1.98, 1.72, 1.66 and 1.62 s; on the 10k circle skirt's first 2 s 7.04
-/// s at 2 and 5.27 s at 0.25 (docs/performance-log.md, "2026-12-06, thirteenth sitting").
+/// s at 2 and 5.27 s at 0.25 (docs/performance-log.md, "2026-12-06: cloth–cloth pairs along the paths from a quarter edge").
 /// At rest the list, which lasts many steps, is renewed instead.
 const SWEPT_FROM_EDGES: f64 = 0.25;
 

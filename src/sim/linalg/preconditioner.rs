@@ -55,7 +55,7 @@ const SHIFTS: [f64; 4] = [0.0, 1e-3, 1e-2, 1e-1];
 /// about 13 MB. Made at a shift of the whole diagonal, the one-ring factor reads an eighth
 /// of the blocks, and the pattern choice (`solver::preconditioning::PatternChoice`) took it
 /// for most factors: a fifth fewer Newton iterations, a third fewer factors and a third less
-/// solve time per CG iteration (docs/performance-log.md, "2026-12-05, third sitting").
+/// solve time per CG iteration (docs/performance-log.md, "2026-12-05: the one-ring factor at larger shifts").
 /// On smaller meshes, whose factors stay in the cache, it was taken too and cost more CG
 /// iterations than it saved (the 2 cm circle skirt's exact path: 84 335 against 49 481).
 const RING_SPLIT_SHIFTS: [f64; 6] = [0.0, 1e-3, 1e-2, 1e-1, 0.3, 1.0];
