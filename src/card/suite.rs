@@ -75,7 +75,7 @@ pub fn scene_fabric(config: &SceneConfig, fabric: &FabricConfig) -> Result<Fabri
     }
     let mut table = toml::Table::try_from(fabric).map_err(|e| bad(format!("fabric: {e}")))?;
     for (key, value) in config.own_fabric_keys.iter().filter(|(k, _)| !matches!(k.as_str(), "preset" | "name" | "description")) {
-        table.insert(key.clone(), value.clone());
+        crate::settings::fabric::lay_over(&mut table, key.clone(), value.clone());
     }
     toml::Value::Table(table).try_into().map_err(|e: toml::de::Error| bad(format!("fabric: {}", e.message())))
 }
