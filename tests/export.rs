@@ -134,9 +134,10 @@ fn the_cloth_reads_back_with_its_normals_weave_and_animation() {
 }
 
 /// A garment exports its texture space (each panel turned into its warp frame, the panels
-/// side by side: `Model::texture_space`) at the weave's scale, so that a print mapped onto
-/// the bias skirt runs along each gore's grain: the exported coordinates are the model's,
-/// and within each triangle their edges are the triangle's own edges in its warp frame.
+/// side by side: `Model::texture_space`) in metres, the material's texture transform
+/// scaling it to the pattern's repeat, so that a print mapped onto the bias skirt runs
+/// along each gore's grain: the exported coordinates are the model's, and within each
+/// triangle their edges are the triangle's own edges in its warp frame.
 #[test]
 fn a_garment_exports_each_panel_in_its_warp_frame() {
     let path = temp("skirt-bias.glb");
@@ -149,7 +150,8 @@ fn a_garment_exports_each_panel_in_its_warp_frame() {
     let r = read(&path);
     let (config, _) = rosette::scene::load_scene("skirt-gored-bias", &["mesh.edge_length=0.05".into()]).unwrap();
     let scene = rosette::scene::Scene::build(config).unwrap();
-    let period = f64::from(rosette::render::RenderOptions::default().weave_period);
+    // Texture coordinates in metres of the cloth at rest.
+    let period = 1.0;
     let frames = scene.model.frames.as_ref().unwrap();
     assert_eq!(r.uv.len(), scene.model.vertex_count());
     for (t, c) in scene.model.triangles.iter().zip(frames) {

@@ -300,6 +300,22 @@ impl Look {
     }
 }
 
+/// A fabric table's `[appearance]` value read, a refusal naming the key at fault: a colour
+/// that is not one (`appearance.colour`, `appearance.sheen.colour`), else the table.
+pub fn from_value(value: &toml::Value) -> Result<Appearance, AppearanceError> {
+    value.clone().try_into().map_err(|e: toml::de::Error| {
+        let not_a_colour = |v: Option<&toml::Value>| v.is_some_and(|v| v.as_str().is_none_or(|s| Colour::parse(s).is_err()));
+        let key = if not_a_colour(value.get("colour")) {
+            "appearance.colour"
+        } else if not_a_colour(value.get("sheen").and_then(|s| s.get("colour"))) {
+            "appearance.sheen.colour"
+        } else {
+            "appearance"
+        };
+        AppearanceError { key, message: format!("fabric.{key}: {}", e.message().trim()) }
+    })
+}
+
 /// Makes a relative texture path in a fabric file's table (`appearance.texture.file`)
 /// relative to the working directory instead of the file's folder `dir`, so that it still
 /// names the same image once the table is merged into a scene or written elsewhere. A
@@ -355,6 +371,20 @@ mod tests {
         assert!(e.message.contains("no/such/print.png") && e.message.contains("no such file"), "{e}");
         assert!(toml::from_str::<Appearance>("color = \"#FFFFFF\"").unwrap_err().to_string().contains("color"));
         assert!(toml::from_str::<Appearance>("colour = \"red\"").unwrap_err().to_string().contains("#RRGGBB"));
+    }
+
+    #[test]
+    fn a_table_that_does_not_read_names_the_colour_at_fault() {
+        let value = |text: &str| toml::Value::Table(toml::from_str(text).unwrap());
+        let e = from_value(&value("colour = \"blue\"")).unwrap_err();
+        assert_eq!(e.key, "appearance.colour");
+        assert!(e.message.starts_with("fabric.appearance.colour: ") && e.message.contains("#RRGGBB"), "{e}");
+        let e = from_value(&value("colour = \"#102030\"\nsheen = { colour = 3 }")).unwrap_err();
+        assert_eq!(e.key, "appearance.sheen.colour");
+        let e = from_value(&value("shine = 1")).unwrap_err();
+        assert_eq!(e.key, "appearance");
+        assert!(e.message.contains("shine"), "{e}");
+        assert_eq!(from_value(&value("weave = \"satin\"")).unwrap().weave, Some(Weave::Satin));
     }
 
     #[test]

@@ -73,6 +73,9 @@ fn from_table(mut table: toml::Table, file: &str) -> Result<LoadedFabric, LoadEr
     let sheets = Sheets::take(&mut table).map_err(sheet_error)?;
     let import = if sheets.is_empty() { Import::default() } else { derive(&sheets, &table).map_err(sheet_error)? };
     let warnings = import::apply(&mut table, &import);
+    if let Some(look) = table.get("appearance") {
+        crate::appearance::from_value(look).map_err(|e| invalid(file, e.message))?;
+    }
     let config: FabricConfig =
         table.try_into().map_err(|e: toml::de::Error| invalid(file, e.message().trim().into()))?;
     config.to_fabric().map_err(|e| {
