@@ -74,13 +74,16 @@ fn the_cloth_reads_back_with_its_normals_weave_and_animation() {
         let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         assert!((length - 1.0).abs() < 1e-5, "normal {n:?}");
     }
-    // The weave's scale: one repeat of the texture (four 1 mm yarns) per 4 mm of cloth, so
-    // the 300 mm disc spans 75 repeats along the warp and the weft. The disc's edge is a
-    // polygon through the circle's points, so its extent is the diameter.
+    // The weave's scale: texture coordinates in metres of cloth, and the material's texture
+    // transform one repeat of the texture (four 1 mm yarns) per 4 mm, so the 300 mm disc
+    // spans 75 repeats along the warp and the weft. The disc's edge is a polygon through the
+    // circle's points, so its extent is the diameter.
     assert!(s.uv.iter().all(|t| t[0].is_finite() && t[1].is_finite()));
+    let scale = s.gltf.materials().next().unwrap().pbr_metallic_roughness().base_color_texture().unwrap().texture_transform().map(|t| t.scale());
     for k in 0..2 {
         let span = s.uv.iter().map(|t| t[k]).fold(f32::NEG_INFINITY, f32::max) - s.uv.iter().map(|t| t[k]).fold(f32::INFINITY, f32::min);
-        assert!((span - 75.0).abs() < 0.75, "uv span {span} repeats, want 75 (300 mm / 4 mm)");
+        let repeats = span * scale.map_or(250.0, |s| s[k]);
+        assert!((repeats - 75.0).abs() < 0.75, "uv span {span} m, {repeats} repeats, want 75 (300 mm / 4 mm)");
     }
     // glTF is y up: the cloth sits on the pedestal's top, the scene's z = 0 to 2 mm, so its
     // heights are y, and the disc spreads over x and z.

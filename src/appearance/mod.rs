@@ -14,7 +14,8 @@
 //!   `KHR_materials_sheen`) on the CPU, for the swatch beside the fabric editor; the shader
 //!   `shaders/scene.wgsl` does the same on the GPU.
 //!
-//! docs/fabric-sheets.md (Appearance) is the user's account of the keys.
+//! docs/appearance.md is the user's account of the keys, the drawing and where each bundled
+//! look came from.
 
 pub mod shade;
 pub mod texture;
