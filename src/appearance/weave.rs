@@ -194,18 +194,23 @@ mod tests {
     fn a_twill_has_diagonal_wales_and_plain_and_satin_have_none() {
         let p = PITCH;
         // A twill repeats along its wales: one yarn over and one yarn back (the floats move
-        // one weft per warp), not along the other diagonal.
+        // one weft per warp), not along the other diagonal, where a step of one yarn each
+        // way moves the binding points two wefts on: of a 3/1 twill's four crossings, two
+        // then lie float on float and two do not, a correlation near a half.
         let twill = Weave::Twill.texels();
         let (wale, across_wales) = (correlation(&twill, p, 3 * p), correlation(&twill, p, p));
-        assert!(wale > 0.8 && across_wales < 0.3, "twill: along its wales {wale:.2}, across {across_wales:.2}");
+        assert!(wale > 0.8 && across_wales < 0.6, "twill: along its wales {wale:.2}, across {across_wales:.2}");
         // A plain weave's two diagonals are alike; a satin shows no diagonal line.
         let plain = Weave::Plain.texels();
         let (d1, d2) = (correlation(&plain, p, p), correlation(&plain, p, 3 * p));
         assert!((d1 - d2).abs() < 0.1, "plain: {d1:.2} against {d2:.2}");
         let satin = Weave::Satin.texels();
+        // Seven crossings in eight are floats, so a shift that moves the binding points off
+        // themselves still leaves six in eight float on float (about 0.8): what shows a line
+        // is a correlation near the twill's wale, which no short diagonal of the satin has.
         for (dx, dy) in [(1, 1), (1, 7), (1, 2), (2, 1)] {
             let c = correlation(&satin, dx * p, dy * p);
-            assert!(c < 0.75, "satin along ({dx}, {dy}) yarns: {c:.2}");
+            assert!(c < 0.9 && c < wale - 0.1, "satin along ({dx}, {dy}) yarns: {c:.2}");
         }
     }
 
