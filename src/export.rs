@@ -2,12 +2,15 @@
 //! viewers open (`rosette run --export`, the viewer's File menu).
 //!
 //! What the file holds: one mesh, the cloth, with positions, unit vertex normals (area
-//! weighted over the triangles round each vertex), texture coordinates in the warp/weft
-//! frame and the plain-weave texture (`assets/weave.png`, embedded) on a two-sided material in
-//! the renderer's cloth colour. Texture u runs along the warp and v along the weft, scaled as
-//! the renderer scales them: one repeat of the texture (four yarns) per
-//! `RenderOptions::weave_period` = 4 mm, so the yarns lie 1 mm apart. Metres, and y up as
-//! glTF has it (the scenes' z up becomes y; the scenes' y becomes −z).
+//! weighted over the triangles round each vertex) and texture coordinates in the warp/weft
+//! frame (texture u along the warp, v along the weft, in metres of the cloth at rest, each
+//! panel of a garment in its own grain), on a two-sided PBR material in the fabric's look
+//! (`crate::appearance`): its colour as the base colour, its weave or print embedded as
+//! the base colour texture, scaled by `KHR_texture_transform` to one repeat per
+//! `Look::repeat_m`, so that the pattern follows each panel's grain as the renderer draws
+//! it; and its sheen as `KHR_materials_sheen` (colour and roughness as the fabric file
+//! gives them). Metres, and y up as glTF has it (the scenes' z up becomes y; the scenes' y
+//! becomes −z).
 //!
 //! Several frames make an animation: the first frame is the mesh and every later frame a
 //! morph target (its positions and normals less the first's), and one animation steps the
@@ -15,7 +18,8 @@
 //! has weight 1 on target k − 1 and 0 elsewhere. Blender imports the targets as shape keys
 //! driven by an action, three.js as morph targets played by its AnimationMixer.
 
-use crate::render::{Frame, RenderOptions};
+use crate::appearance::{Look, Pattern, linear_to_srgb};
+use crate::render::Frame;
 use crate::scene::Topology;
 use std::sync::Arc;
 use glam::DVec3;
@@ -23,8 +27,9 @@ use serde_json::{Value, json};
 use std::path::Path;
 use thiserror::Error;
 
-/// The plain-weave texture, embedded in every file.
-const WEAVE_PNG: &[u8] = include_bytes!("../assets/weave.png");
+/// How strongly a weave's light and shade are kept in the exported texture: as the
+/// renderer draws it (`render::renderer::WEAVE_STRENGTH`).
+const WEAVE_STRENGTH: f32 = 0.55;
 
 /// glTF's component types and buffer targets (glTF 2.0 §5).
 const FLOAT: u32 = 5126;
@@ -123,7 +128,7 @@ impl Builder {
 /// targets; where the mesh changes during the run (a garment's weld, a finer level of the
 /// fast path) each mesh is a node of its own, shown by its scale (1, or 0 to hide it) from
 /// its first frame until the next mesh's, with a step interpolation.
-pub fn glb(name: &str, frames: &[ClothFrame]) -> Result<Vec<u8>, ExportError> {
+pub fn glb(name: &str, frames: &[ClothFrame], look: &Look) -> Result<Vec<u8>, ExportError> {
     if frames.is_empty() {
         return Err(ExportError::Empty("no frame".into()));
     }
@@ -191,22 +196,18 @@ pub fn glb(name: &str, frames: &[ClothFrame]) -> Result<Vec<u8>, ExportError> {
         }
         nodes.push(node);
     }
-    let image_view = b.view(WEAVE_PNG, None);
-    let [r, g, bl] = RenderOptions::default().front_color.map(srgb_to_linear);
+    let (material, image) = material(&mut b, look);
     let mut document = json!({
         "asset": { "version": "2.0", "generator": format!("rosette {}", env!("CARGO_PKG_VERSION")) },
+        "extensionsUsed": ["KHR_materials_sheen", "KHR_texture_transform"],
         "scene": 0,
         "scenes": [{ "nodes": (0..nodes.len()).collect::<Vec<_>>() }],
         "nodes": nodes,
         "meshes": meshes,
-        "materials": [{
-            "name": "woven cloth",
-            "doubleSided": true,
-            "pbrMetallicRoughness": { "baseColorFactor": [r, g, bl, 1.0], "baseColorTexture": { "index": 0 }, "metallicFactor": 0.0, "roughnessFactor": 0.9 },
-        }],
-        // Linear filtering with mipmaps, repeating both ways: the weave tiles the cloth.
+        "materials": [material],
+        // Linear filtering with mipmaps, repeating both ways: the pattern tiles the cloth.
         "samplers": [{ "magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497 }],
-        "images": [{ "bufferView": image_view, "mimeType": "image/png", "name": "plain weave, 4 yarns each way" }],
+        "images": [image],
         "textures": [{ "sampler": 0, "source": 0 }],
         "accessors": b.accessors,
         "bufferViews": b.views,
@@ -251,12 +252,8 @@ fn segment_mesh(b: &mut Builder, frames: &[ClothFrame], label: &str, start: f64)
     let index_accessor = b.accessors.len() - 1;
     let positions: Vec<[f32; 3]> = first.iter().map(|&p| to_gltf(p)).collect();
     let normals = vertex_normals(first, &topology.triangles);
-    let period = f64::from(RenderOptions::default().weave_period);
-    let uv: Vec<[f32; 2]> = Frame::from_cloth(first, &topology.triangles, &topology.texture, topology.warp_angle)
-        .cloth_uv
-        .iter()
-        .map(|[u, v]| [(f64::from(*u) / period) as f32, (f64::from(*v) / period) as f32])
-        .collect();
+    // Metres along the warp and the weft; the material's texture transform scales them.
+    let uv: Vec<[f32; 2]> = Frame::from_cloth(first, &topology.triangles, &topology.texture, topology.warp_angle).cloth_uv;
     let position = b.floats(&positions, "VEC3", Some(ARRAY_BUFFER));
     let normal = b.floats(&normals, "VEC3", Some(ARRAY_BUFFER));
     let texcoord = b.floats(&uv, "VEC2", Some(ARRAY_BUFFER));
@@ -298,13 +295,56 @@ fn segment_mesh(b: &mut Builder, frames: &[ClothFrame], label: &str, start: f64)
 }
 
 /// Writes [`glb`] to `path`.
-pub fn write_glb(path: &Path, name: &str, frames: &[ClothFrame]) -> Result<(), ExportError> {
-    let bytes = glb(name, frames)?;
+pub fn write_glb(path: &Path, name: &str, frames: &[ClothFrame], look: &Look) -> Result<(), ExportError> {
+    let bytes = glb(name, frames, look)?;
     crate::io::write::whole(path, &bytes).map_err(|e| ExportError::Write { path: path.display().to_string(), message: e.to_string() })
 }
 
-fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+/// The cloth's material in `look` and its image (embedded in `b`): a two-sided PBR
+/// material, not metallic and rough, the look's colour times its pattern, the pattern
+/// repeated along the warp and the weft (`KHR_texture_transform`), and the look's sheen
+/// (`KHR_materials_sheen`; none when the look has no sheen).
+fn material(b: &mut Builder, look: &Look) -> (Value, Value) {
+    let (bytes, mime_type, name) = match &look.pattern {
+        Pattern::Weave(w) => (weave_png(look), "image/png", format!("{} weave, {} yarns each way", w.name(), w.yarns())),
+        Pattern::Image(t) => (t.encoded.to_vec(), t.mime_type, t.name.clone()),
+    };
+    let image_view = b.view(&bytes, None);
+    let [r, g, bl] = look.colour.linear();
+    let [warp, weft] = look.repeat_m.map(|m| (1.0 / m) as f32);
+    let mut material = json!({
+        "name": "woven cloth",
+        "doubleSided": true,
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [r, g, bl, 1.0],
+            "baseColorTexture": { "index": 0, "extensions": { "KHR_texture_transform": { "scale": [warp, weft] } } },
+            "metallicFactor": 0.0,
+            "roughnessFactor": 0.9,
+        },
+    });
+    let [sr, sg, sb] = look.sheen.map_or([0.0; 3], |s| s.colour.linear());
+    let roughness = look.sheen.map_or(0.0, |s| s.roughness);
+    material["extensions"] = json!({ "KHR_materials_sheen": { "sheenColorFactor": [sr, sg, sb], "sheenRoughnessFactor": roughness } });
+    (material, json!({ "bufferView": image_view, "mimeType": mime_type, "name": name }))
+}
+
+/// A weave's texture as the renderer draws it: its light and shade about its mean, at the
+/// renderer's strength, so that the material's base colour is the cloth's colour on average.
+fn weave_png(look: &Look) -> Vec<u8> {
+    let texels = look.texels();
+    let mean = crate::appearance::shade::mean_linear(&texels);
+    let mut image = (*texels).clone();
+    for p in image.pixels_mut() {
+        for k in 0..3 {
+            let t = crate::appearance::srgb_to_linear(f32::from(p[k]) / 255.0);
+            let v = 1.0 + WEAVE_STRENGTH * (t / mean - 1.0);
+            p[k] = (255.0 * linear_to_srgb(v)).round() as u8;
+        }
+    }
+    let mut bytes = Vec::new();
+    // Encoding an image in memory cannot fail; an empty image would leave the texture out.
+    let _ = image::DynamicImage::ImageRgba8(image).write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png);
+    bytes
 }
 
 /// Keeps the cloth's positions through a run for an animation of `frames` frames spread

@@ -9,8 +9,10 @@
 //! solutions (elastica, off-axis formulas) the tests and the chart compare against; `chart`
 //! sweeps integrators, time steps and meshes for speed against accuracy; `bench` times
 //! scenes; `io` reads the files a user names and writes every output whole, never over
-//! an input.
+//! an input; `appearance` is a fabric's look (colour, weave or print, sheen), which every
+//! picture and the glTF export draw it with.
 pub mod app;
+pub mod appearance;
 pub mod bench;
 pub mod card;
 pub mod chart;

@@ -74,13 +74,16 @@ fn the_cloth_reads_back_with_its_normals_weave_and_animation() {
         let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         assert!((length - 1.0).abs() < 1e-5, "normal {n:?}");
     }
-    // The weave's scale: one repeat of the texture (four 1 mm yarns) per 4 mm of cloth, so
-    // the 300 mm disc spans 75 repeats along the warp and the weft. The disc's edge is a
-    // polygon through the circle's points, so its extent is the diameter.
+    // The weave's scale: texture coordinates in metres of cloth, and the material's texture
+    // transform one repeat of the texture (four 1 mm yarns) per 4 mm, so the 300 mm disc
+    // spans 75 repeats along the warp and the weft. The disc's edge is a polygon through the
+    // circle's points, so its extent is the diameter.
     assert!(s.uv.iter().all(|t| t[0].is_finite() && t[1].is_finite()));
+    let scale = s.gltf.materials().next().unwrap().pbr_metallic_roughness().base_color_texture().unwrap().texture_transform().map(|t| t.scale());
     for k in 0..2 {
         let span = s.uv.iter().map(|t| t[k]).fold(f32::NEG_INFINITY, f32::max) - s.uv.iter().map(|t| t[k]).fold(f32::INFINITY, f32::min);
-        assert!((span - 75.0).abs() < 0.75, "uv span {span} repeats, want 75 (300 mm / 4 mm)");
+        let repeats = span * scale.map_or(250.0, |s| s[k]);
+        assert!((repeats - 75.0).abs() < 0.75, "uv span {span} m, {repeats} repeats, want 75 (300 mm / 4 mm)");
     }
     // glTF is y up: the cloth sits on the pedestal's top, the scene's z = 0 to 2 mm, so its
     // heights are y, and the disc spreads over x and z.
@@ -134,9 +137,10 @@ fn the_cloth_reads_back_with_its_normals_weave_and_animation() {
 }
 
 /// A garment exports its texture space (each panel turned into its warp frame, the panels
-/// side by side: `Model::texture_space`) at the weave's scale, so that a print mapped onto
-/// the bias skirt runs along each gore's grain: the exported coordinates are the model's,
-/// and within each triangle their edges are the triangle's own edges in its warp frame.
+/// side by side: `Model::texture_space`) in metres, the material's texture transform
+/// scaling it to the pattern's repeat, so that a print mapped onto the bias skirt runs
+/// along each gore's grain: the exported coordinates are the model's, and within each
+/// triangle their edges are the triangle's own edges in its warp frame.
 #[test]
 fn a_garment_exports_each_panel_in_its_warp_frame() {
     let path = temp("skirt-bias.glb");
@@ -149,7 +153,8 @@ fn a_garment_exports_each_panel_in_its_warp_frame() {
     let r = read(&path);
     let (config, _) = rosette::scene::load_scene("skirt-gored-bias", &["mesh.edge_length=0.05".into()]).unwrap();
     let scene = rosette::scene::Scene::build(config).unwrap();
-    let period = f64::from(rosette::render::RenderOptions::default().weave_period);
+    // Texture coordinates in metres of the cloth at rest.
+    let period = 1.0;
     let frames = scene.model.frames.as_ref().unwrap();
     assert_eq!(r.uv.len(), scene.model.vertex_count());
     for (t, c) in scene.model.triangles.iter().zip(frames) {

@@ -61,7 +61,13 @@ fn background() -> [u8; 3] {
     BACKGROUND.map(|c| (c * 255.0).round() as u8)
 }
 
-/// The fabric's front and back tints are both clearly red-orange; the background, the
+/// The scene's frame with its cloth in the default look, whatever its fabric: these tests
+/// find the cloth by its terracotta (each fabric's own look is tests/appearance.rs's).
+fn terracotta(scene: &Scene, map: Option<ColorMap>) -> Frame {
+    Frame { look: rosette::appearance::Look::default(), ..Frame::from_scene(scene, map) }
+}
+
+/// The default look's front and back tints are both clearly red-orange; the background, the
 /// shadow and the props are neutral greys.
 fn is_cloth(p: &image::Rgba<u8>) -> bool {
     let [r, g, b] = [p[0], p[1], p[2]].map(f32::from);
@@ -89,7 +95,7 @@ fn check_fabric_picture(name: &str, image: &image::RgbaImage) {
     assert_eq!(image.dimensions(), (SIZE[0], SIZE[1]), "{name}");
     let colours: HashSet<[u8; 3]> = image.pixels().map(|p| [p[0], p[1], p[2]]).collect();
     // A blank frame has one colour. A flat strip still has its weave, its shading and its
-    // shadow's steps (105–111 colours at this size); a flat 1 m tablecloth, whose 4 mm weave
+    // shadow's penumbra (over a hundred colours at this size); a flat 1 m tablecloth, whose 4 mm weave
     // averages out at 3 mm a pixel, has 38.
     assert!(colours.len() >= 20, "{name}: only {} distinct colours: blank", colours.len());
     let cloth = centre_fraction(image, is_cloth);
@@ -117,7 +123,7 @@ fn check_fabric_picture(name: &str, image: &image::RgbaImage) {
 fn every_bundled_scene_renders_cloth_in_the_centre_and_background_at_the_corners() {
     for scene in SCENES {
         let started = std::time::Instant::now();
-        let frame = Frame::from_scene(&stepped(scene.name), None);
+        let frame = terracotta(&stepped(scene.name), None);
         let image = shoot(scene.name, &frame, &RenderOptions::default(), "");
         check_fabric_picture(scene.name, &image);
         eprintln!("{}: {:.2} s", scene.name, started.elapsed().as_secs_f64());
@@ -127,9 +133,9 @@ fn every_bundled_scene_renders_cloth_in_the_centre_and_background_at_the_corners
 #[test]
 fn colour_map_draws_its_scale_and_legend() {
     let scene = stepped("tensile-bias");
-    let fabric = shoot("tensile-bias", &Frame::from_scene(&scene, None), &RenderOptions::default(), "");
+    let fabric = shoot("tensile-bias", &terracotta(&scene, None), &RenderOptions::default(), "");
     for map in [ColorMap::Shear, ColorMap::Bending] {
-        let image = shoot("tensile-bias", &Frame::from_scene(&scene, Some(map)), &RenderOptions::default(), &format!("-{map}"));
+        let image = shoot("tensile-bias", &terracotta(&scene, Some(map)), &RenderOptions::default(), &format!("-{map}"));
         // The cloth takes the map's colours: hardly any fabric red is left in the centre.
         let red = centre_fraction(&image, is_cloth);
         assert!(red < 0.5 * centre_fraction(&fabric, is_cloth), "{map}: {:.1} % still fabric-coloured", 100.0 * red);
@@ -152,7 +158,7 @@ fn colour_map_draws_its_scale_and_legend() {
 #[test]
 fn wireframe_draws_the_edges_over_the_cloth() {
     let scene = stepped("cantilever");
-    let frame = Frame::from_scene(&scene, None);
+    let frame = terracotta(&scene, None);
     let plain = shoot("cantilever", &frame, &RenderOptions::default(), "");
     let wired = shoot("cantilever", &frame, &RenderOptions { wireframe: true, ..RenderOptions::default() }, "-wireframe");
     // Pixels the lines darken; 360 triangles give a few thousand at this size.

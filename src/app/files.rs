@@ -10,13 +10,16 @@ use std::path::Path;
 
 /// A scene as TOML that `rosette run FILE` and the viewer's Open read back.
 pub fn scene_toml(config: &SceneConfig) -> Result<String, String> {
-    toml::to_string_pretty(config).map_err(|e| format!("cannot write the scene as TOML: {e}"))
+    // The fabric's texture is found from wherever the scene is saved.
+    let mut config = config.clone();
+    config.fabric.appearance = config.fabric.appearance.anchored(config.base_dir.as_deref());
+    toml::to_string_pretty(&config).map_err(|e| format!("cannot write the scene as TOML: {e}"))
 }
 
 /// A fabric as TOML, a file that a scene's `fabric.preset` can name. The `preset` key is
 /// left out: every value is written, so the file stands alone.
 pub fn fabric_toml(fabric: &FabricConfig) -> Result<String, String> {
-    let fabric = FabricConfig { preset: None, ..fabric.clone() };
+    let fabric = FabricConfig { preset: None, appearance: fabric.appearance.anchored(None), ..fabric.clone() };
     toml::to_string_pretty(&fabric).map_err(|e| format!("cannot write the fabric as TOML: {e}"))
 }
 

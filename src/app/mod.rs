@@ -7,7 +7,8 @@
 //!   [`plots`]: live test plots and their references; [`files`]: TOML, OBJ, CSV;
 //!   [`chart_view`]: the speed/accuracy charts of `rosette chart`; [`card_view`]: the
 //!   fabric card of the fabric being edited; [`pin`]: a fabric's result kept beside the live
-//!   one; [`pattern_view`]: a garment's grains and its flat pattern.
+//!   one; [`pattern_view`]: a garment's grains and its flat pattern; [`swatch`]: the
+//!   fabric's look beside its editor.
 //! - [`script`]: scripted sessions read and checked; [`session`]: one played in the window
 //!   through the panels' own code.
 pub mod action;
@@ -21,6 +22,7 @@ pub mod pin;
 pub mod plots;
 pub mod script;
 pub mod session;
+pub mod swatch;
 pub mod ui;
 pub mod worker;
 pub mod viewer;

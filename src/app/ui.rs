@@ -81,6 +81,8 @@ pub struct ViewerUi {
     pub pinned: Option<Pinned>,
     /// A garment's grains and flat pattern.
     pub pattern: PatternView,
+    /// The fabric's look beside its editor.
+    swatch: super::swatch::Swatch,
 }
 
 impl Default for ViewerUi {
@@ -108,6 +110,7 @@ impl Default for ViewerUi {
             card: CardView::default(),
             pinned: None,
             pattern: PatternView::default(),
+            swatch: Default::default(),
         }
     }
 }
@@ -362,6 +365,7 @@ impl ViewerUi {
             self.messages.push(e);
         }
         let Some(fabric) = &mut self.fabric else { return };
+        self.swatch.show(ui, fabric, scene.base_dir.as_deref());
         let mut changed = false;
         // Rigidities are shown in µN·m, the size they come in.
         let micro = |v: &mut f64| *v * 1e6;

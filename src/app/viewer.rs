@@ -533,7 +533,7 @@ impl App {
             FileDialog::ExportCsv => write(files::measures_csv(&snapshot.measures, &self.ui.history.names, &self.ui.history.rows))?,
             FileDialog::ExportGltf => {
                 let frames = [crate::export::ClothFrame { time: snapshot.time, topology: Arc::clone(&snapshot.topology), positions: snapshot.positions.clone() }];
-                crate::export::write_glb(path, &snapshot.scene_name, &frames).map_err(|e| e.to_string())?;
+                crate::export::write_glb(path, &snapshot.scene_name, &frames, &snapshot_look(&snapshot)).map_err(|e| e.to_string())?;
             }
         }
         self.ui.notice = Some(format!("saved {}", path.display()));
@@ -656,7 +656,13 @@ fn snapshot_frame(snapshot: &Snapshot, ui: &ViewerUi) -> Frame {
         .map(|(p, t)| PropMesh { positions: p.iter().map(|v| v.as_vec3().to_array()).collect(), triangles: t.clone() })
         .collect();
     frame.floor_z = snapshot.ground_z.map(|z| z as f32).or_else(|| frame.floor_below());
+    frame.look = snapshot_look(snapshot);
     frame
+}
+
+/// The look of the fabric the snapshot's scene runs (the default where it no longer checks).
+fn snapshot_look(snapshot: &Snapshot) -> crate::appearance::Look {
+    crate::appearance::Look::or_default(&snapshot.config.fabric.appearance, snapshot.config.base_dir.as_deref())
 }
 
 /// The 3D view alone (no panels), as the window's camera sees it, rendered offscreen at

@@ -121,6 +121,9 @@ pub struct FabricInfo {
     pub areal_density_g_per_m2: f64,
     pub thickness_mm: f64,
     pub poisson_warp: f64,
+    /// How it is drawn (the fabric's `[appearance]`, a texture's path made absolute).
+    #[serde(default, skip_serializing_if = "crate::appearance::Appearance::is_empty")]
+    pub appearance: crate::appearance::Appearance,
 }
 
 /// One tensile pull: the measured curve against the curve the fabric was given.

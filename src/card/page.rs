@@ -13,6 +13,8 @@ use plotters::prelude::*;
 pub const SIZE: (u32, u32) = (1400, 920);
 /// Each drape picture, pixels.
 pub const PICTURE: [u32; 2] = [456, 270];
+/// The fabric's swatch at the header's right, pixels.
+const SWATCH: [u32; 2] = [210, 50];
 
 const HEADER: u32 = 78;
 const ROW: u32 = 310;
@@ -90,12 +92,17 @@ pub fn draw(card: &Card, pictures: Result<&[RgbaImage; 2], &str>) -> Result<Vec<
         };
         blit(&mut buffer, SIZE.0, &picture, at);
     }
+    let look = crate::appearance::Look::or_default(&card.fabric.appearance, None);
+    blit(&mut buffer, SIZE.0, &crate::appearance::shade::swatch(&look, SWATCH), (SIZE.0 - SWATCH[0] - 12, 6));
     Ok(buffer)
 }
 
 fn header(root: &Area, card: &Card) -> DrawResult {
     let f = &card.fabric;
     root.draw_text(&format!("Fabric card: {}", f.name), &font(26), (16, 10))?;
+    // Under the swatch (drawn over the page afterwards, at its right): the look in words.
+    let look = crate::appearance::Look::or_default(&f.appearance, None).summary();
+    root.draw_text(&look, &font(11).color(&GREY), (SIZE.0 as i32 - SWATCH[0] as i32 - 12, 60))?;
     let facts = format!(
         "{} · {:.0} g/m² · {:.3} mm thick · ν = {:.2} · virtual laboratory of rosette {}",
         f.source,

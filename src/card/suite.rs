@@ -75,7 +75,7 @@ pub fn scene_fabric(config: &SceneConfig, fabric: &FabricConfig) -> Result<Fabri
     }
     let mut table = toml::Table::try_from(fabric).map_err(|e| bad(format!("fabric: {e}")))?;
     for (key, value) in config.own_fabric_keys.iter().filter(|(k, _)| !matches!(k.as_str(), "preset" | "name" | "description")) {
-        table.insert(key.clone(), value.clone());
+        crate::settings::fabric::lay_over(&mut table, key.clone(), value.clone());
     }
     toml::Value::Table(table).try_into().map_err(|e: toml::de::Error| bad(format!("fabric: {}", e.message())))
 }
@@ -146,6 +146,7 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
     // Everything checked before the first run.
     let material = fabric.to_fabric().map_err(|e| CardError::BadInput(e.to_string()))?;
     let stiffness = BendingStiffness::new(&material).map_err(|e| CardError::BadInput(e.to_string()))?;
+    fabric.look(None).map_err(|e| CardError::BadInput(format!("fabric.{}: {}", e.key, e.message)))?;
     let drape = drape_config(DRAPE_SCENE, fabric)?;
     let Results { runs, pull, scene, metrics, times } = run_suite(fabric, &drape, progress)?;
     let input_b = |d: Direction| stiffness.rigidity_at(-d.warp_angle_deg().to_radians());
@@ -159,6 +160,7 @@ pub fn compute(fabric: &FabricConfig, source: &str, sheets: Option<(&Sheets, &Im
             areal_density_g_per_m2: 1e3 * p.areal_density,
             thickness_mm: 1e3 * p.thickness,
             poisson_warp: p.poisson_warp,
+            appearance: fabric.appearance.anchored(None),
         },
         tensile: tensile_section(fabric, &runs, &pull),
         pure_bending: bending_section(&runs, input_b),

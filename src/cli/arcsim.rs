@@ -2,7 +2,7 @@
 
 use super::outputs::{self, ARCSIM_FILE};
 use super::bad_input;
-use rosette::fabric::arcsim::export::{export as to_material, to_json};
+use rosette::fabric::arcsim::export::{export as to_material, to_json_with_look};
 use rosette::io::guard::Plan;
 use rosette::errln;
 use std::path::Path;
@@ -41,6 +41,7 @@ pub fn export(spec: &str, out: Option<&Path>, force: bool) -> ExitCode {
     if let Some(who) = loaded.sheets.measured_by() {
         comments.push(format!("Measured by {who}; cite their publication with the data."));
     }
-    let text = to_json(&material, &comments);
+    // The look travels with the material, its texture found from wherever the file goes.
+    let text = to_json_with_look(&material, &comments, &loaded.config.appearance.anchored(None));
     outputs::write_or_print(out, &text, "the material", "")
 }

@@ -33,7 +33,8 @@ pub fn list() -> ExitCode {
                     None if sheets.is_empty() => "representative values".into(),
                     None => "typical of its class".into(),
                 };
-                outln!("{:<24} {:<16} {:<52} {}", b.name, from, who, f.config.description);
+                let look = f.config.look(None).map_or_else(|e| format!("look: {e}"), |l| l.summary());
+                outln!("{:<24} {:<16} {:<40} {:<52} {}", b.name, from, look, who, f.config.description);
             }
             Err(e) => outln!("{:<20} error: {e}", b.name),
         }
@@ -61,7 +62,9 @@ pub fn import(sheet: &str, out: Option<&Path>, force: bool) -> ExitCode {
     for w in &loaded.warnings {
         errln!("warning: {w}");
     }
-    let table = match toml::Table::try_from(&loaded.config) {
+    // A texture's path is written absolute: the fabric file may be written anywhere.
+    let config = rosette::settings::FabricConfig { appearance: loaded.config.appearance.anchored(None), ..loaded.config.clone() };
+    let table = match toml::Table::try_from(&config) {
         Ok(t) => t,
         Err(e) => return bad_input(e),
     };

@@ -272,7 +272,8 @@ pub fn run(spec: &str, overrides: &[String], limits: &RunLimits, outputs: &RunOu
             Some(r) => r.finish(scene.state.time, scene.topology(), &scene.state.x),
             None => vec![rosette::export::ClothFrame { time: scene.state.time, topology: Arc::clone(scene.topology()), positions: scene.state.x.clone() }],
         };
-        match rosette::export::write_glb(path, &name, &frames) {
+        let look = rosette::appearance::Look::or_default(&scene.config.fabric.appearance, scene.config.base_dir.as_deref());
+        match rosette::export::write_glb(path, &name, &frames, &look) {
             Ok(()) => errln!("wrote {} ({} frame{})", path.display(), frames.len(), if frames.len() == 1 { "" } else { "s" }),
             Err(e) => fail(format!("--export: {e}")),
         }

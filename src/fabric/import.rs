@@ -450,7 +450,12 @@ impl Deriver<'_> {
 /// fabric file: they win, and they feed the conversions that need them (the bias).
 pub fn derive(sheets: &Sheets, explicit: &toml::Table) -> Result<Import, SheetError> {
     if let Some(arcsim) = &sheets.arcsim {
-        return Ok(super::arcsim::project::derive(&arcsim.material(), &arcsim.origin(), explicit));
+        let mut import = super::arcsim::project::derive(&arcsim.material(), &arcsim.origin(), explicit);
+        if let Some(look) = &arcsim.appearance {
+            let source = format!("{}: the material file's \"appearance\"", arcsim.origin());
+            import.derived.push(Derived { key: "appearance", value: look.clone(), source, default: false, section: None });
+        }
+        return Ok(import);
     }
     let mut d = Deriver { sheets, explicit, out: Import::default() };
     let rho = d.areal_density()?;

@@ -60,6 +60,10 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<LoadedFabric, LoadError> {
     let table = crate::io::read::parse_toml(text, Some(std::path::Path::new(file)), crate::io::read::FileKind::Fabric)
         .map_err(|message| PresetError::Syntax { file: file.into(), message })?;
     refuse_fabric_preset(&table).map_err(|message| invalid(file, message))?;
+    let mut table = table;
+    if let Some(dir) = std::path::Path::new(file).parent() {
+        crate::appearance::resolve_in_table(&mut table, dir);
+    }
     from_table(table, file)
 }
 
@@ -69,12 +73,18 @@ fn from_table(mut table: toml::Table, file: &str) -> Result<LoadedFabric, LoadEr
     let sheets = Sheets::take(&mut table).map_err(sheet_error)?;
     let import = if sheets.is_empty() { Import::default() } else { derive(&sheets, &table).map_err(sheet_error)? };
     let warnings = import::apply(&mut table, &import);
+    if let Some(look) = table.get("appearance") {
+        crate::appearance::from_value(look).map_err(|e| invalid(file, e.message))?;
+    }
     let config: FabricConfig =
         table.try_into().map_err(|e: toml::de::Error| invalid(file, e.message().trim().into()))?;
     config.to_fabric().map_err(|e| {
         let message = explain::explain(&import, e.key(), &e.to_string()).map_or_else(|| e.to_string(), |(text, _)| text);
         invalid(file, message)
     })?;
+    // The file's own texture paths were made relative to the working directory as it was
+    // read (`read_preset`, `parse_fabric`).
+    config.look(None).map_err(|e| invalid(file, e.message))?;
     Ok(LoadedFabric { file: file.into(), config, sheets, import, warnings })
 }
 

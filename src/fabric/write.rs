@@ -73,7 +73,7 @@ pub fn fabric_file(table: &toml::Table, sheets: &Sheets, import: &Import, origin
         "bending_bias",
         "bending_curve",
     ];
-    let others = table.keys().filter(|k| !order.contains(&k.as_str()) && !matches!(k.as_str(), "name" | "description" | "preset"));
+    let others = table.keys().filter(|k| !order.contains(&k.as_str()) && !matches!(k.as_str(), "name" | "description" | "preset" | "appearance"));
     for key in order.iter().map(|k| k.to_string()).chain(others.cloned()) {
         let Some(v) = table.get(&key) else { continue };
         let source = match import.get(&key) {
@@ -84,6 +84,16 @@ pub fn fabric_file(table: &toml::Table, sheets: &Sheets, import: &Import, origin
         let unit = key_unit(&key);
         let line = format!("{key} = {}", value(v));
         out += &if unit.is_empty() { format!("{line}\n") } else { format!("{line}    # {unit}\n") };
+    }
+    if let Some(look) = table.get("appearance") {
+        let source = match import.get("appearance") {
+            Some(d) if &d.value == look => d.source.clone(),
+            _ => format!("given directly in {origin}"),
+        };
+        let mut holder = toml::Table::new();
+        holder.insert("appearance".into(), look.clone());
+        out += &format!("\n# How the fabric is drawn; {source}\n");
+        out += &toml::to_string(&holder).expect("a TOML table writes back");
     }
     if let Some(a) = &sheets.arcsim {
         out += &arcsim_comments(a);

@@ -28,6 +28,8 @@ pub enum FileKind {
     Pattern,
     /// A scripted session for the viewer (TOML).
     Script,
+    /// A fabric's texture: a PNG or JPEG image (`[appearance] texture`).
+    Image,
 }
 
 impl FileKind {
@@ -43,6 +45,10 @@ impl FileKind {
             FileKind::Arcsim => 1 << 20,
             // GarmentCode's largest bundled specification (a jumpsuit, 12 panels) is 48 kB.
             FileKind::Pattern => 16 << 20,
+            // A 4096 × 4096 photograph of a print is a few MB as JPEG, up to about 50 MB as
+            // a PNG of noise; past that it is not a texture (the decoded size has its own
+            // bound, `appearance::texture::MAX_SIDE`).
+            FileKind::Image => 64 << 20,
         }
     }
 
@@ -56,6 +62,7 @@ impl FileKind {
             FileKind::Arcsim => "material file in ARCSim's JSON format",
             FileKind::Pattern => "pattern in GarmentCode's JSON format",
             FileKind::Script => "viewer script",
+            FileKind::Image => "texture image (PNG or JPEG)",
         }
     }
 
@@ -67,6 +74,7 @@ impl FileKind {
             FileKind::Obj => "obj",
             FileKind::Csv => "csv",
             FileKind::Arcsim | FileKind::Pattern => "json",
+            FileKind::Image => "png",
         }
     }
 }
@@ -184,6 +192,13 @@ fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
 /// (a folder, a device such as /dev/zero, a FIFO, a socket), larger than the kind's
 /// limit, or not UTF-8. The file is remembered for the output guard.
 pub fn read_text(path: &Path, kind: FileKind) -> Result<String, ReadError> {
+    let bytes = read_bytes(path, kind)?;
+    String::from_utf8(bytes).map_err(|_| ReadError::NotText { path: path.display().to_string(), noun: kind.noun() })
+}
+
+/// Reads the regular file at `path` as bytes of `kind` (an image), with the checks of
+/// [`read_text`] but for the text's. The file is remembered for the output guard.
+pub fn read_bytes(path: &Path, kind: FileKind) -> Result<Vec<u8>, ReadError> {
     let shown = path.display().to_string();
     let io = |e: std::io::Error| ReadError::Io { path: shown.clone(), message: e.to_string() };
     let metadata = match std::fs::metadata(path) {
@@ -208,7 +223,6 @@ pub fn read_text(path: &Path, kind: FileKind) -> Result<String, ReadError> {
     if bytes.len() as u64 > kind.limit() {
         return Err(too_large(&shown, bytes.len() as u64, kind));
     }
-    let text = String::from_utf8(bytes).map_err(|_| ReadError::NotText { path: shown.clone(), noun: kind.noun() })?;
     let identity = Identity {
         path: path.to_path_buf(),
         canonical: std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
@@ -216,7 +230,7 @@ pub fn read_text(path: &Path, kind: FileKind) -> Result<String, ReadError> {
         kind,
     };
     READ.lock().unwrap_or_else(|p| p.into_inner()).push(identity);
-    Ok(text)
+    Ok(bytes)
 }
 
 fn too_large(path: &str, bytes: u64, kind: FileKind) -> ReadError {

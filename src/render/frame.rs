@@ -1,6 +1,7 @@
 //! The snapshot the renderer draws: plain arrays, no solver types.
 
 use super::colormap::{ColorMap, ScalarField};
+use crate::appearance::Look;
 use crate::scene::Scene;
 use crate::sim::contact::props::PropShape;
 use glam::{DVec2, DVec3};
@@ -21,6 +22,8 @@ pub struct Frame {
     pub props: Vec<PropMesh>,
     /// Height of the floor the shadow falls on, m; no shadow when `None`.
     pub floor_z: Option<f32>,
+    /// How the cloth is drawn where no field colours it: its fabric's look.
+    pub look: Look,
 }
 
 /// A prop's surface.
@@ -48,14 +51,16 @@ impl Frame {
         frame
     }
 
-    /// The scene's current state. With `color_map`, the cloth is coloured by that field
-    /// (strain or curvature per triangle, averaged onto the vertices). A ground prop
-    /// becomes the floor; without one the floor is put a little below everything.
+    /// The scene's current state, the cloth in its fabric's look. With `color_map`, the
+    /// cloth is coloured by that field (strain or curvature per triangle, averaged onto the
+    /// vertices). A ground prop becomes the floor; without one the floor is put a little
+    /// below everything.
     pub fn from_scene(scene: &Scene, color_map: Option<ColorMap>) -> Self {
         let model = &scene.model;
         let x = &scene.state.x;
         let (texture, warp_angle) = model.texture_space();
         let mut frame = Self::from_cloth(x, &model.triangles, texture, warp_angle);
+        frame.look = Look::or_default(&scene.config.fabric.appearance, scene.config.base_dir.as_deref());
         if let Some(map) = color_map {
             frame.cloth_scalar = Some(scalar_field(scene, map));
         }

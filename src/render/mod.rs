@@ -38,17 +38,22 @@
 //! lighting to sRGB themselves; on an `*Srgb` target the hardware does it. Either way the
 //! pixels come out the same.
 //!
-//! What is drawn: the cloth lit from a key light and a sky/ground ambient, two-sided (the
-//! back a lighter tint than the front), textured with a plain weave (`assets/weave.png`,
-//! warp along texture u) at `options.weave_period`; or coloured by a strain or curvature
-//! field on a [`ColorMap`] scale, with a legend bar at the right edge. Props in a neutral
-//! grey. A soft shadow of cloth and props on the floor plane, projected along the light and
-//! blurred with distance from the floor (no floor is drawn: the shadow falls on the
-//! background, like a photographer's shadow catcher). Optionally the mesh edges over the
-//! cloth (the paper's Fig. 6a).
+//! What is drawn: the cloth in its fabric's look ([`Frame::look`], `crate::appearance`):
+//! its colour, its weave or printed image repeated along the warp (texture u) and the weft
+//! (v) at the look's repeat, so that the pattern turns with each panel's grain, lit from a
+//! key light, a fill and a sky/ground ambient, with the look's sheen (the Charlie sheen of
+//! glTF's `KHR_materials_sheen`, as `appearance::shade` computes it for the swatch);
+//! two-sided, the back a lighter tint of the front. Or the cloth coloured by a strain or
+//! curvature field on a [`ColorMap`] scale, with a legend bar at the right edge. Props in
+//! a neutral grey. A soft shadow of cloth and props on the floor plane: a shadow map seen
+//! from a light nearly overhead, filtered with a penumbra that widens with the height of
+//! what casts it (percentage-closer soft shadows, `shadow.rs`), falling on the background
+//! (no floor is drawn, like a photographer's shadow catcher). Optionally the mesh edges
+//! over the cloth (the paper's Fig. 6a).
 //!
-//! Shaders are `shaders/scene.wgsl` (cloth, props, shadow) and `shaders/overlay.wgsl`
-//! (legend), bundled with `include_str!`. Nothing here needs more than WebGL2-level limits.
+//! Shaders are `shaders/scene.wgsl` (cloth, props, the floor's shadow),
+//! `shaders/shadow_map.wgsl` (the depth seen from the shadow's light) and
+//! `shaders/overlay.wgsl` (legend), bundled with `include_str!`. Nothing here needs more than WebGL2-level limits.
 
 mod camera;
 mod colormap;
@@ -57,6 +62,7 @@ mod frame;
 mod headless;
 mod legend;
 mod renderer;
+mod shadow;
 
 pub use camera::Camera;
 pub use colormap::{ColorMap, ScalarField};
@@ -78,17 +84,10 @@ pub struct RenderOptions {
     pub shadow: bool,
     /// Background, sRGB 0..1.
     pub background: [f32; 3],
-    /// Front face of the cloth (the side its triangle normals point to), sRGB 0..1.
-    pub front_color: [f32; 3],
-    /// Back face of the cloth, sRGB 0..1.
-    pub back_color: [f32; 3],
     /// Props, sRGB 0..1.
     pub prop_color: [f32; 3],
     /// Wireframe lines, sRGB 0..1.
     pub wire_color: [f32; 3],
-    /// Length of one repeat of the weave texture along the warp and the weft, m (the
-    /// texture holds four yarns each way, so the yarn spacing is a quarter of this).
-    pub weave_period: f32,
 }
 
 impl Default for RenderOptions {
@@ -98,11 +97,8 @@ impl Default for RenderOptions {
             legend: true,
             shadow: true,
             background: BACKGROUND,
-            front_color: [0.72, 0.25, 0.16],
-            back_color: [0.85, 0.55, 0.42],
             prop_color: [0.62, 0.63, 0.65],
             wire_color: [0.08, 0.08, 0.10],
-            weave_period: 0.004,
         }
     }
 }

@@ -2,6 +2,8 @@
 
 use super::camera::Camera;
 use super::frame::{Frame, PropMesh};
+use super::shadow::{self, ShadowMap};
+use crate::appearance::{Look, Pattern, shade::mean_linear};
 use super::legend::{self, GRADIENT_ROWS, GRADIENT_TEXELS, OverlayVertex};
 use super::{RenderOptions, font};
 use bytemuck::{Pod, Zeroable};
@@ -10,9 +12,6 @@ use wgpu::util::DeviceExt;
 
 /// Depth buffer format the renderer draws with (the caller's, for [`Renderer::paint`]).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-
-/// The plain-weave texture: one repeat, four yarns each way, warp along u.
-const WEAVE_PNG: &[u8] = include_bytes!("../../assets/weave.png");
 
 /// Where the key light comes from: high, and to the right of the default view, so folds
 /// and buckles are modelled by light and shade.
@@ -25,11 +24,14 @@ const SHADOW_FROM: Vec3 = Vec3::new(0.2, -0.15, 1.0);
 /// How much the core of the shadow darkens the background, 0..1.
 const SHADOW_STRENGTH: f32 = 0.32;
 
-/// Penumbra spread per metre of height above the floor (per step of the blur).
-const PENUMBRA: f32 = 0.035;
+/// How strongly a generated weave's light and shade show on the cloth, 0..1: a little over
+/// half, so that the folds' light and shade read through the weave. A print is drawn at
+/// full strength.
+const WEAVE_STRENGTH: f32 = 0.55;
 
-/// Shadow copies: the core and three rings of eight (`vs_shadow` in `shaders/scene.wgsl`).
-const SHADOW_INSTANCES: u32 = 25;
+/// How far the back of the cloth is lightened towards white (sRGB), so that the two sides
+/// read apart where a hem turns.
+const BACK_LIGHTENING: f32 = 0.35;
 
 /// Uniforms, laid out as `Globals` in the shaders.
 #[repr(C)]
@@ -45,18 +47,22 @@ struct Globals {
     background: [f32; 4],
     shadow: [f32; 4],
     params: [f32; 4],
+    light_view_proj: [[f32; 4]; 4],
+    cloth: [f32; 4],
+    sheen: [f32; 4],
+    shadow_map: [f32; 4],
 }
 
 /// A vertex of the cloth or a prop (buffers are de-indexed: three per triangle).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct Vertex {
-    position: [f32; 3],
-    normal: [f32; 3],
+pub(super) struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
     /// Rest position along warp and weft, m.
-    uv: [f32; 2],
+    pub uv: [f32; 2],
     /// Position on the colour scale 0..1, or −1 for the fabric look.
-    scale: f32,
+    pub scale: f32,
 }
 
 /// A vertex buffer that grows as needed and is rewritten each frame.
@@ -109,12 +115,18 @@ pub struct Renderer {
     sample_count: u32,
     cloth_pipeline: wgpu::RenderPipeline,
     prop_pipeline: wgpu::RenderPipeline,
-    shadow_pipeline: wgpu::RenderPipeline,
+    floor_pipeline: wgpu::RenderPipeline,
     overlay_pipeline: wgpu::RenderPipeline,
     globals: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    fixed: FixedTextures,
+    shadow_map: ShadowMap,
     bind_group: wgpu::BindGroup,
+    /// The look's pattern now on the GPU, and the mean of its texels in linear light.
+    pattern: (Pattern, f32),
     cloth: GrowingBuffer,
     props: GrowingBuffer,
+    floor: GrowingBuffer,
     overlay: GrowingBuffer,
     targets: Option<Targets>,
     /// Of the last `prepare`.
@@ -130,8 +142,9 @@ struct Target<'a> {
     multisample: wgpu::MultisampleState,
 }
 
-/// The one bind group's layout: the globals (0), the weave texture and its sampler (1, 2),
-/// the colour scales and theirs (3, 4) and the font atlas (5).
+/// The one bind group's layout: the globals (0), the cloth's pattern and its sampler (1, 2),
+/// the colour scales and theirs (3, 4), the font atlas (5), and the shadow map with its
+/// comparison sampler (6, 7).
 fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
     let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
@@ -168,6 +181,17 @@ fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             texture_entry(3),
             sampler_entry(4),
             texture_entry(5),
+            wgpu::BindGroupLayoutEntry {
+                binding: 6,
+                visibility,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry { binding: 7, visibility, ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison), count: None },
         ],
     })
 }
@@ -182,7 +206,7 @@ fn depth_state(write: bool, compare: wgpu::CompareFunction) -> Option<wgpu::Dept
     })
 }
 
-/// The cloth, prop and shadow pipelines of `shaders/scene.wgsl`.
+/// The cloth, prop and floor pipelines of `shaders/scene.wgsl`.
 fn scene_pipelines(device: &wgpu::Device, target: &Target) -> [wgpu::RenderPipeline; 3] {
     let scene_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("rosette scene shader"),
@@ -221,10 +245,9 @@ fn scene_pipelines(device: &wgpu::Device, target: &Target) -> [wgpu::RenderPipel
     };
     let cloth_pipeline = scene_pipeline("rosette cloth", "vs_main", "fs_cloth", None, true);
     let prop_pipeline = scene_pipeline("rosette props", "vs_main", "fs_prop", None, true);
-    // Min blending: where shadow copies overlap, the darkest wins instead of stacking.
-    let min = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor: wgpu::BlendFactor::One, operation: wgpu::BlendOperation::Min };
-    let shadow_pipeline = scene_pipeline("rosette shadow", "vs_shadow", "fs_shadow", Some(wgpu::BlendState { color: min, alpha: min }), false);
-    [cloth_pipeline, prop_pipeline, shadow_pipeline]
+    // The floor hides nothing: it shows only where nothing is in front of it.
+    let floor_pipeline = scene_pipeline("rosette floor", "vs_main", "fs_floor", None, false);
+    [cloth_pipeline, prop_pipeline, floor_pipeline]
 }
 
 /// The screen-space overlay's pipeline (`shaders/overlay.wgsl`): legends and labels,
@@ -266,52 +289,85 @@ fn overlay_pipeline(device: &wgpu::Device, target: &Target) -> wgpu::RenderPipel
     })
 }
 
-/// The bind group of [`bind_group_layout`]: `globals`, and the weave, colour-scale and font
-/// textures uploaded through `queue` with their samplers.
-fn bind_group(device: &wgpu::Device, queue: &wgpu::Queue, layout: &wgpu::BindGroupLayout, globals: &wgpu::Buffer) -> wgpu::BindGroup {
-    let weave = weave_texture(device, queue);
-    let gradient = device.create_texture_with_data(
-        queue,
-        &texture_descriptor("rosette colour scales", [GRADIENT_TEXELS, GRADIENT_ROWS], 1, wgpu::TextureFormat::Rgba8UnormSrgb),
-        wgpu::util::TextureDataOrder::LayerMajor,
-        &legend::gradient_texels(),
-    );
-    let (font_w, font_h, font_texels) = font::atlas();
-    let font = device.create_texture_with_data(
-        queue,
-        &texture_descriptor("rosette font", [font_w, font_h], 1, wgpu::TextureFormat::R8Unorm),
-        wgpu::util::TextureDataOrder::LayerMajor,
-        &font_texels,
-    );
-    let weave_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("rosette weave sampler"),
-        address_mode_u: wgpu::AddressMode::Repeat,
-        address_mode_v: wgpu::AddressMode::Repeat,
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        mipmap_filter: wgpu::MipmapFilterMode::Linear,
-        ..Default::default()
-    });
-    let gradient_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("rosette gradient sampler"),
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        ..Default::default()
-    });
-    let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
-    let (weave_view, gradient_view, font_view) = (view(&weave), view(&gradient), view(&font));
+/// The textures every frame uses whatever the look: the colour scales and the font atlas,
+/// with the samplers of these and of the cloth's pattern.
+struct FixedTextures {
+    gradient: wgpu::TextureView,
+    font: wgpu::TextureView,
+    pattern_sampler: wgpu::Sampler,
+    gradient_sampler: wgpu::Sampler,
+}
+
+impl FixedTextures {
+    fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        let gradient = device.create_texture_with_data(
+            queue,
+            &texture_descriptor("rosette colour scales", [GRADIENT_TEXELS, GRADIENT_ROWS], 1, wgpu::TextureFormat::Rgba8UnormSrgb),
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &legend::gradient_texels(),
+        );
+        let (font_w, font_h, font_texels) = font::atlas();
+        let font = device.create_texture_with_data(
+            queue,
+            &texture_descriptor("rosette font", [font_w, font_h], 1, wgpu::TextureFormat::R8Unorm),
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &font_texels,
+        );
+        // The pattern repeats both ways: it tiles the cloth.
+        let pattern_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("rosette pattern sampler"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let gradient_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("rosette gradient sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+        Self { gradient: view(&gradient), font: view(&font), pattern_sampler, gradient_sampler }
+    }
+}
+
+/// The bind group of [`bind_group_layout`]: `globals`, the cloth's `pattern`, the fixed
+/// textures and the shadow map.
+fn bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    globals: &wgpu::Buffer,
+    fixed: &FixedTextures,
+    shadow_map: &ShadowMap,
+    pattern: &wgpu::TextureView,
+) -> wgpu::BindGroup {
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("rosette bind group"),
         layout,
         entries: &[
             wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&weave_view) },
-            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&weave_sampler) },
-            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&gradient_view) },
-            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&gradient_sampler) },
-            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&font_view) },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(pattern) },
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&fixed.pattern_sampler) },
+            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&fixed.gradient) },
+            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&fixed.gradient_sampler) },
+            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&fixed.font) },
+            wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&shadow_map.view) },
+            wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::Sampler(&shadow_map.sampler) },
         ],
     })
+}
+
+/// Whether two patterns are the same texture: the same weave, or the same decoded image
+/// (compared by address: the decoder keeps one per file).
+fn same_pattern(a: &Pattern, b: &Pattern) -> bool {
+    match (a, b) {
+        (Pattern::Weave(a), Pattern::Weave(b)) => a == b,
+        (Pattern::Image(a), Pattern::Image(b)) => std::sync::Arc::ptr_eq(a, b),
+        _ => false,
+    }
 }
 
 impl Renderer {
@@ -325,7 +381,7 @@ impl Renderer {
             immediate_size: 0,
         });
         let target = Target { layout: &pipeline_layout, color_format, multisample: wgpu::MultisampleState { count: sample_count, ..Default::default() } };
-        let [cloth_pipeline, prop_pipeline, shadow_pipeline] = scene_pipelines(device, &target);
+        let [cloth_pipeline, prop_pipeline, floor_pipeline] = scene_pipelines(device, &target);
         let overlay_pipeline = overlay_pipeline(device, &target);
         let globals = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("rosette globals"),
@@ -333,24 +389,43 @@ impl Renderer {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let bind_group = bind_group(device, queue, &layout, &globals);
+        let fixed = FixedTextures::new(device, queue);
+        let shadow_map = ShadowMap::new(device);
+        let look = Look::default();
+        let (pattern_view, mean) = pattern_texture(device, queue, &look);
+        let bind_group = bind_group(device, &layout, &globals, &fixed, &shadow_map, &pattern_view);
         Self {
             color_format,
             sample_count,
             cloth_pipeline,
             prop_pipeline,
-            shadow_pipeline,
+            floor_pipeline,
             overlay_pipeline,
             globals,
+            layout,
+            fixed,
+            shadow_map,
             bind_group,
+            pattern: (look.pattern, mean),
             cloth: GrowingBuffer::new("rosette cloth vertices"),
             props: GrowingBuffer::new("rosette prop vertices"),
+            floor: GrowingBuffer::new("rosette floor vertices"),
             overlay: GrowingBuffer::new("rosette overlay vertices"),
             targets: None,
             size: [1, 1],
             background: RenderOptions::default().background,
             shadow: false,
         }
+    }
+
+    /// Puts `look`'s pattern on the GPU unless it is there already.
+    fn use_look(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, look: &Look) {
+        if same_pattern(&self.pattern.0, &look.pattern) {
+            return;
+        }
+        let (view, mean) = pattern_texture(device, queue, look);
+        self.bind_group = bind_group(device, &self.layout, &self.globals, &self.fixed, &self.shadow_map, &view);
+        self.pattern = (look.pattern.clone(), mean);
     }
 
     /// The colour format and sample count given to [`Renderer::new`].
@@ -371,32 +446,38 @@ impl Renderer {
         let size = [size[0].max(1), size[1].max(1)];
         self.size = size;
         self.background = options.background;
-        self.shadow = options.shadow && frame.floor_z.is_some();
+        self.use_look(device, queue, &frame.look);
+        let shadow = if options.shadow { shadow::setup(frame, SHADOW_FROM) } else { None };
+        self.shadow = shadow.is_some();
         let aspect = f64::from(size[0]) / f64::from(size[1]);
-        let linear = |c: [f32; 3], a: f32| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), a];
-        let light = LIGHT_FROM.normalize();
         let scalar = frame.cloth_scalar.as_ref();
         let globals = Globals {
             view_proj: camera.view_proj(aspect).to_cols_array_2d(),
             eye: camera.eye().as_vec3().extend(1.0).to_array(),
-            light: light.extend(0.0).to_array(),
-            front: linear(options.front_color, 1.0),
-            back: linear(options.back_color, 1.0),
+            light: LIGHT_FROM.normalize().extend(0.0).to_array(),
             prop: linear(options.prop_color, 1.0),
             wire: linear(options.wire_color, if options.wireframe { 0.7 } else { 0.0 }),
             background: linear(options.background, SHADOW_STRENGTH),
             shadow: (-SHADOW_FROM.normalize()).extend(frame.floor_z.unwrap_or(0.0)).to_array(),
             params: [
-                1.0 / options.weave_period.max(1e-6),
+                0.0,
                 if self.color_format.is_srgb() { 0.0 } else { 1.0 },
                 scalar.map_or(0.5, |s| (s.map.row() as f32 + 0.5) / GRADIENT_ROWS as f32),
-                PENUMBRA,
+                0.0,
             ],
+            light_view_proj: shadow.as_ref().map_or(glam::Mat4::IDENTITY, |s| s.light_view_proj).to_cols_array_2d(),
+            shadow_map: shadow.as_ref().map_or([1.0; 4], |s| s.params),
+            ..look_globals(&frame.look, self.pattern.1)
         };
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
         self.cloth.upload(device, queue, &cloth_vertices(frame));
         let props: Vec<Vertex> = frame.props.iter().flat_map(prop_vertices).collect();
         self.props.upload(device, queue, &props);
+        self.floor.upload(device, queue, shadow.as_ref().map_or(&[][..], |s| &s.floor[..]));
+        if let Some(s) = &shadow {
+            let meshes: Vec<(&wgpu::Buffer, u32)> = [self.cloth.filled(), self.props.filled()].into_iter().flatten().collect();
+            self.shadow_map.draw(device, queue, s.light_view_proj, &meshes);
+        }
         let overlay = match scalar {
             Some(field) if options.legend => legend::legend(field, size[0], size[1]),
             _ => Vec::new(),
@@ -455,8 +536,8 @@ impl Renderer {
     }
 
     /// Draws the prepared frame into a pass the caller began (see the module documentation
-    /// for what the pass needs). Opaque geometry first, then the shadow (depth-tested
-    /// against it, so it only shows on the background), then the legend.
+    /// for what the pass needs). Opaque geometry first, then the floor with its shadow
+    /// (depth-tested against it, so it only shows on the background), then the legend.
     pub fn paint(&self, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_bind_group(0, &self.bind_group, &[]);
         let meshes = [(&self.cloth_pipeline, self.cloth.filled()), (&self.prop_pipeline, self.props.filled())];
@@ -467,12 +548,12 @@ impl Renderer {
                 pass.draw(0..count, 0..1);
             }
         }
-        if self.shadow {
-            pass.set_pipeline(&self.shadow_pipeline);
-            for (buffer, count) in [self.cloth.filled(), self.props.filled()].into_iter().flatten() {
-                pass.set_vertex_buffer(0, buffer.slice(..));
-                pass.draw(0..count, 0..SHADOW_INSTANCES);
-            }
+        if self.shadow
+            && let Some((buffer, count)) = self.floor.filled()
+        {
+            pass.set_pipeline(&self.floor_pipeline);
+            pass.set_vertex_buffer(0, buffer.slice(..));
+            pass.draw(0..count, 0..1);
         }
         if let Some((buffer, count)) = self.overlay.filled() {
             pass.set_pipeline(&self.overlay_pipeline);
@@ -495,10 +576,51 @@ fn texture_descriptor(label: &'static str, [width, height]: [u32; 2], mips: u32,
     }
 }
 
-/// The weave texture with its mipmap chain (box-filtered in linear light), so the weave
-/// fades to its mean colour instead of shimmering when the cloth is far away.
-fn weave_texture(device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::Texture {
-    let image = image::load_from_memory_with_format(WEAVE_PNG, image::ImageFormat::Png).expect("assets/weave.png is a valid PNG").to_rgba8();
+/// Linear RGBA of an sRGB colour, with alpha `a`.
+fn linear(c: [f32; 3], a: f32) -> [f32; 4] {
+    [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), a]
+}
+
+/// The globals that come from the fabric's look: the front and back tints, the pattern's
+/// repeat and strength (`mean`: its texels' mean in linear light) and the sheen.
+fn look_globals(look: &Look, mean: f32) -> Globals {
+    let front = look.colour.srgb();
+    let back = front.map(|c| c + BACK_LIGHTENING * (1.0 - c));
+    // A weave is a multiplier about its mean, so the cloth keeps its colour on average;
+    // a print is the cloth's colour as it is.
+    let (normaliser, strength) = match look.pattern {
+        Pattern::Weave(_) => (1.0 / mean.max(1e-3), WEAVE_STRENGTH),
+        Pattern::Image(_) => (1.0, 1.0),
+    };
+    let [warp, weft] = look.repeat_m.map(|m| (1.0 / m.max(1e-6)) as f32);
+    Globals {
+        front: linear(front, 1.0),
+        back: linear(back, 1.0),
+        cloth: [warp, weft, normaliser, strength],
+        // A negative roughness: no sheen.
+        sheen: look.sheen.map_or([0.0, 0.0, 0.0, -1.0], |s| {
+            let [r, g, b] = s.colour.linear();
+            [r, g, b, s.roughness]
+        }),
+        ..Globals::zeroed()
+    }
+}
+
+/// The look's pattern as a texture with its mipmap chain (box-filtered in linear light), so
+/// that the weave or print fades to its mean colour instead of shimmering when the cloth is
+/// far away; and the mean of its texels in linear light. An image larger than the device
+/// takes is scaled down to fit.
+fn pattern_texture(device: &wgpu::Device, queue: &wgpu::Queue, look: &Look) -> (wgpu::TextureView, f32) {
+    let texels = look.texels();
+    let limit = device.limits().max_texture_dimension_2d.max(1);
+    let image = if texels.width() > limit || texels.height() > limit {
+        let scale = f64::from(limit) / f64::from(texels.width().max(texels.height()));
+        let (w, h) = ((f64::from(texels.width()) * scale) as u32, (f64::from(texels.height()) * scale) as u32);
+        image::imageops::resize(&*texels, w.max(1), h.max(1), image::imageops::FilterType::Triangle)
+    } else {
+        (*texels).clone()
+    };
+    let mean = mean_linear(&image);
     let (width, height) = image.dimensions();
     let mut level: Vec<[f32; 4]> = image.pixels().map(|p| [0, 1, 2, 3].map(|c| if c < 3 { srgb_to_linear(f32::from(p[c]) / 255.0) } else { f32::from(p[c]) / 255.0 })).collect();
     let (mut w, mut h) = (width as usize, height as usize);
@@ -529,12 +651,13 @@ fn weave_texture(device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::Texture {
         }
         (level, w, h) = (next, nw, nh);
     }
-    device.create_texture_with_data(
+    let texture = device.create_texture_with_data(
         queue,
-        &texture_descriptor("rosette weave", [width, height], mips, wgpu::TextureFormat::Rgba8UnormSrgb),
+        &texture_descriptor("rosette cloth pattern", [width, height], mips, wgpu::TextureFormat::Rgba8UnormSrgb),
         wgpu::util::TextureDataOrder::LayerMajor,
         &data,
-    )
+    );
+    (texture.create_view(&wgpu::TextureViewDescriptor::default()), mean)
 }
 
 pub(crate) fn srgb_to_linear(c: f32) -> f32 {

@@ -280,7 +280,7 @@ fn merge_fabric(mut table: toml::Table, fabric_file: Option<toml::Table>) -> tom
     let mut fabric = fabric_file.unwrap_or_default();
     let preset = scene_fabric.get("preset").cloned();
     for (k, v) in scene_fabric {
-        fabric.insert(k, v);
+        crate::settings::fabric::lay_over(&mut fabric, k, v);
     }
     if let Some(p) = preset {
         fabric.insert("preset".into(), p);

@@ -4,7 +4,7 @@
 //!
 //! - [`schema`]: the scene file's sections, as serde reads them, and [`fabric`] the fabric
 //!   table;
-//! - [`registry`]: the scenes, fabrics and prop meshes bundled into the binary;
+//! - [`registry`]: the scenes, fabrics, prop meshes and textures bundled into the binary;
 //! - [`read`]: the one reader of "a bundled name or a file", and `--set` overrides;
 //! - [`validate`]: every value checked before any work, each refusal naming its key.
 //!

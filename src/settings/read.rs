@@ -133,9 +133,13 @@ pub fn read_preset(kind: PresetKind, spec: &str, base: Option<&Path>, key: Optio
         return garment_pattern_table(&path, &file, key).map(|table| (table, file));
     }
     let text = read_text(&path, kind.file_kind()).map_err(|source| PresetError::Read { key, source })?;
-    let table = parse_toml(&text, Some(&path), kind.file_kind()).map_err(|message| PresetError::Syntax { file: file.clone(), message })?;
+    let mut table = parse_toml(&text, Some(&path), kind.file_kind()).map_err(|message| PresetError::Syntax { file: file.clone(), message })?;
     if kind == PresetKind::Fabric {
         refuse_fabric_preset(&table).map_err(|message| PresetError::Invalid { file: file.clone(), message })?;
+        // A texture beside the fabric file is found from wherever the fabric is used.
+        if let Some(dir) = path.parent() {
+            crate::appearance::resolve_in_table(&mut table, dir);
+        }
     }
     Ok((table, file))
 }

@@ -34,3 +34,16 @@ pub struct Asset {
 
 /// Bundled meshes, addressed by their path under the repository (`assets/cushion.obj`).
 pub const ASSETS: &[Asset] = &[Asset { name: "assets/cushion.obj", text: include_str!("../../assets/cushion.obj") }];
+
+/// An image bundled into the binary.
+pub struct Image {
+    pub name: &'static str,
+    pub bytes: &'static [u8],
+}
+
+/// Bundled textures for `[appearance.texture]`, addressed by their path under the repository
+/// (`assets/prints/white-dots-on-black.png`); `assets/prints/prints.py` draws them.
+pub const IMAGES: &[Image] = &[
+    Image { name: "assets/prints/white-dots-on-black.png", bytes: include_bytes!("../../assets/prints/white-dots-on-black.png") },
+    Image { name: "assets/prints/pink-ribbon-on-brown.png", bytes: include_bytes!("../../assets/prints/pink-ribbon-on-brown.png") },
+];

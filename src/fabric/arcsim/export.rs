@@ -17,6 +17,7 @@
 //! docs/fabric-sheets.md for what a fabric's curves lose between the samples.
 
 use super::material::{ArcsimMaterial, BENDING_COLUMNS};
+use crate::appearance::Appearance;
 use super::model::{BIAS_ROW, HINGE_FACTOR, STRAIN_SAMPLE, WARP_ROW, WEFT_ROW, sample_curvatures};
 use crate::sim::{BendingStiffness, Fabric, FabricError};
 use std::f64::consts::FRAC_PI_4;
@@ -73,6 +74,13 @@ pub fn secant_rigidity(fabric: &Fabric, rigidity: f64, kappa: f64) -> f64 {
 /// accepts, as in its own `aluminium.json`) saying where it came from. Numbers to ten
 /// significant figures.
 pub fn to_json(m: &ArcsimMaterial, comments: &[String]) -> String {
+    to_json_with_look(m, comments, &Appearance::default())
+}
+
+/// [`to_json`] with the fabric's look as an `"appearance"` object beside the tables (left
+/// out when the fabric has none): ARCSim reads the keys it knows and passes over the rest,
+/// and Rosette reads it back as the fabric's `[appearance]`.
+pub fn to_json_with_look(m: &ArcsimMaterial, comments: &[String], appearance: &Appearance) -> String {
     let number = |v: f64| {
         let v: f64 = format!("{v:.9e}").parse().expect("a formatted float parses");
         format!("{v:?}")
@@ -84,8 +92,14 @@ pub fn to_json(m: &ArcsimMaterial, comments: &[String]) -> String {
     for c in comments {
         out += &format!("// {c}\n");
     }
+    let look = if appearance.is_empty() {
+        String::new()
+    } else {
+        let json = serde_json::to_string(appearance).expect("an appearance serialises");
+        format!(",\n    \"appearance\": {json}")
+    };
     out += &format!(
-        "{{\n    \"density\": {},\n    \"stretching\": [\n{}\n    ],\n    \"bending\": [\n{}\n    ]\n}}\n",
+        "{{\n    \"density\": {},\n    \"stretching\": [\n{}\n    ],\n    \"bending\": [\n{}\n    ]{look}\n}}\n",
         number(m.density),
         rows(&stretching),
         rows(&bending)

@@ -61,8 +61,15 @@ fn field_error(file: &str, field: impl Into<String>, message: impl Into<String>)
 /// Reads an ARCSim material file: a regular file of a material's size (`io::read`), JSON with
 /// comments allowed.
 pub fn read_file(path: &Path) -> Result<ArcsimMaterial, ArcsimError> {
+    Ok(read_document(path)?.0)
+}
+
+/// Reads an ARCSim material file as [`read_file`] does, with the fabric's look where the
+/// file carries one (an `"appearance"` object, which Rosette writes beside the three tables
+/// and ARCSim's reader passes over).
+pub fn read_document(path: &Path) -> Result<(ArcsimMaterial, Option<serde_json::Value>), ArcsimError> {
     let text = read_text(path)?;
-    parse_json(&text, &path.display().to_string())
+    parse_document(&text, &path.display().to_string())
 }
 
 /// The text of a material file, read only if it is a regular file of a material's size
@@ -74,6 +81,12 @@ pub fn read_text(path: &Path) -> Result<String, ArcsimError> {
 
 /// Parses an ARCSim material's JSON (comments allowed); `file` names it in errors.
 pub fn parse_json(text: &str, file: &str) -> Result<ArcsimMaterial, ArcsimError> {
+    Ok(parse_document(text, file)?.0)
+}
+
+/// Parses an ARCSim material's JSON, and returns its `"appearance"` object beside it, if it
+/// has one (not checked here: it becomes the fabric's `[appearance]`, checked with it).
+pub fn parse_document(text: &str, file: &str) -> Result<(ArcsimMaterial, Option<serde_json::Value>), ArcsimError> {
     let stripped = strip_comments(text).map_err(|(line, column)| ArcsimError::Syntax {
         file: file.into(),
         message: "a /* comment */ is not closed".into(),
@@ -90,11 +103,16 @@ pub fn parse_json(text: &str, file: &str) -> Result<ArcsimMaterial, ArcsimError>
         .as_object()
         .ok_or_else(|| field_error(file, "(top level)", "must be an object { \"density\": …, \"stretching\": […], \"bending\": […] }"))?;
     for key in object.keys() {
-        if !["density", "stretching", "bending"].contains(&key.as_str()) {
-            return Err(field_error(file, key.as_str(), "not a key of an ARCSim material; its keys are density, stretching and bending"));
+        if !["density", "stretching", "bending", "appearance"].contains(&key.as_str()) {
+            return Err(field_error(
+                file,
+                key.as_str(),
+                "not a key of an ARCSim material; its keys are density, stretching and bending (and Rosette's appearance)",
+            ));
         }
     }
-    from_fields(file, "", object.get("density"), object.get("stretching"), object.get("bending"))
+    let material = from_fields(file, "", object.get("density"), object.get("stretching"), object.get("bending"))?;
+    Ok((material, object.get("appearance").cloned()))
 }
 
 /// Builds a material from its three fields (JSON values, from a material file or a fabric

@@ -64,6 +64,22 @@ pub struct ArcsimSection {
     pub data: Option<String>,
     /// Free text: `source`, `specimen`, `note`, `measured_by`.
     pub text: BTreeMap<String, String>,
+    /// The material file's `"appearance"` (a fabric Rosette exported), as a fabric table's
+    /// `[appearance]`, a relative texture path made relative to the working directory.
+    pub appearance: Option<toml::Value>,
+}
+
+/// A material file's `"appearance"` as a fabric table's `[appearance]`, its texture's
+/// relative path taken from the file's folder; `file` names the file in errors.
+fn look_table(json: &serde_json::Value, file: &str) -> Result<toml::Value, ArcsimError> {
+    let field = |message: String| ArcsimError::Field { file: file.into(), field: "appearance".into(), message };
+    let value = toml::Value::try_from(json).map_err(|e| field(format!("cannot be read as a fabric's [appearance]: {e}")))?;
+    let mut holder = toml::Table::new();
+    holder.insert("appearance".into(), value);
+    if let Some(dir) = std::path::Path::new(file).parent() {
+        crate::appearance::resolve_in_table(&mut holder, dir);
+    }
+    Ok(holder.remove("appearance").expect("just inserted"))
 }
 
 /// The section's keys besides the free-text ones.
@@ -113,13 +129,16 @@ impl ArcsimSection {
             }
         }
         let inline = ["density", "stretching", "bending"].iter().any(|k| table.contains_key(*k));
+        let mut appearance = None;
         let (file_material, data) = match (table.get("data"), inline) {
             (Some(_), true) => {
                 return Err(field("data", "and inline samples both given: name the material file or give density, stretching and bending, not both".into()));
             }
             (Some(path), false) => {
                 let path = path.as_str().ok_or_else(|| field("data", format!("{path} must be the material file's path in quotes")))?;
-                (material::read_file(std::path::Path::new(path))?, Some(path.to_string()))
+                let (m, look) = material::read_document(std::path::Path::new(path))?;
+                appearance = look.map(|json| look_table(&json, path)).transpose()?;
+                (m, Some(path.to_string()))
             }
             (None, true) => {
                 let json = |k: &str| table.get(k).map(|v| serde_json::to_value(v).expect("TOML values convert to JSON"));
@@ -129,7 +148,7 @@ impl ArcsimSection {
             (None, false) => return Err(field("data", "missing: name an ARCSim material file (data = \"FILE.json\") or give density, stretching and bending".into())),
         };
         // The multiplied material must still be in range.
-        let section = Self { file_material, multipliers, data, text };
+        let section = Self { file_material, multipliers, data, text, appearance };
         let applied = section.material();
         let (low, high) = material::DENSITY_RANGE;
         if !(low..=high).contains(&applied.density) {

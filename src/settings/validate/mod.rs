@@ -134,6 +134,7 @@ pub fn check_scene_for(c: &SceneConfig, run_duration: Option<f64>) -> Result<(),
         extent.size
     };
     c.material().map_err(|e| invalid(&format!("fabric.{}", e.key()), e.to_string()))?;
+    c.fabric.look(c.base_dir.as_deref()).map_err(|e| invalid(&format!("fabric.{}", e.key), e.message))?;
     check_test(c, extent)?;
     check_contact(c, extent)?;
     for (i, p) in c.props.iter().enumerate() {
