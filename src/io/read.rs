@@ -28,6 +28,11 @@ pub enum FileKind {
     Pattern,
     /// A scripted session for the viewer (TOML).
     Script,
+    /// A sewing pattern from pattern CAD: DXF in the AAMA / ASTM D6673 convention, read as
+    /// bytes (its text may be in a Windows code page, or the file binary DXF, refused).
+    Dxf,
+    /// The seams of a DXF pattern (TOML).
+    Seams,
 }
 
 impl FileKind {
@@ -36,13 +41,16 @@ impl FileKind {
     /// of the largest prop contact resolves well (a million triangles) is about 60 MB.
     pub fn limit(self) -> u64 {
         match self {
-            FileKind::Scene | FileKind::Fabric | FileKind::Script => 1 << 20,
+            FileKind::Scene | FileKind::Fabric | FileKind::Script | FileKind::Seams => 1 << 20,
             FileKind::Obj => 128 << 20,
             FileKind::Csv => 16 << 20,
             // A material is under 2 kB; its comments may be long.
             FileKind::Arcsim => 1 << 20,
             // GarmentCode's largest bundled specification (a jumpsuit, 12 panels) is 48 kB.
             FileKind::Pattern => 16 << 20,
+            // A pattern of two pieces exported by Valentina is 30 to 60 kB; a graded style of
+            // thirty pieces in every size a few MB.
+            FileKind::Dxf => 16 << 20,
         }
     }
 
@@ -56,6 +64,8 @@ impl FileKind {
             FileKind::Arcsim => "material file in ARCSim's JSON format",
             FileKind::Pattern => "pattern in GarmentCode's JSON format",
             FileKind::Script => "viewer script",
+            FileKind::Dxf => "pattern file (DXF)",
+            FileKind::Seams => "seams file",
         }
     }
 
@@ -63,7 +73,8 @@ impl FileKind {
     /// contents are not quoted in messages (see [`quotable`]).
     pub fn extension(self) -> &'static str {
         match self {
-            FileKind::Scene | FileKind::Fabric | FileKind::Script => "toml",
+            FileKind::Scene | FileKind::Fabric | FileKind::Script | FileKind::Seams => "toml",
+            FileKind::Dxf => "dxf",
             FileKind::Obj => "obj",
             FileKind::Csv => "csv",
             FileKind::Arcsim | FileKind::Pattern => "json",
@@ -181,6 +192,13 @@ fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
 /// (a folder, a device such as /dev/zero, a FIFO, a socket), larger than the kind's
 /// limit, or not UTF-8. The file is remembered for the output guard.
 pub fn read_text(path: &Path, kind: FileKind) -> Result<String, ReadError> {
+    let bytes = read_bytes(path, kind)?;
+    String::from_utf8(bytes).map_err(|_| ReadError::NotText { path: path.display().to_string(), noun: kind.noun() })
+}
+
+/// Reads the regular file at `path` as bytes of `kind`, with the checks of [`read_text`]
+/// but its text's encoding; the file is remembered for the output guard.
+pub fn read_bytes(path: &Path, kind: FileKind) -> Result<Vec<u8>, ReadError> {
     let shown = path.display().to_string();
     let io = |e: std::io::Error| ReadError::Io { path: shown.clone(), message: e.to_string() };
     let metadata = match std::fs::metadata(path) {
@@ -205,7 +223,6 @@ pub fn read_text(path: &Path, kind: FileKind) -> Result<String, ReadError> {
     if bytes.len() as u64 > kind.limit() {
         return Err(too_large(&shown, bytes.len() as u64, kind));
     }
-    let text = String::from_utf8(bytes).map_err(|_| ReadError::NotText { path: shown.clone(), noun: kind.noun() })?;
     let identity = Identity {
         path: path.to_path_buf(),
         canonical: std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
@@ -213,7 +230,7 @@ pub fn read_text(path: &Path, kind: FileKind) -> Result<String, ReadError> {
         kind,
     };
     READ.lock().unwrap_or_else(|p| p.into_inner()).push(identity);
-    Ok(text)
+    Ok(bytes)
 }
 
 fn too_large(path: &str, bytes: u64, kind: FileKind) -> ReadError {
