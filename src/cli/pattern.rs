@@ -163,8 +163,8 @@ pub fn seams(pattern: &Path, out: Option<&Path>, args: &PatternArgs, force: bool
         // A seams file beside the pattern gives its placement, which the suggestions follow.
         let existing = seams_file(pattern, None)?;
         check_out(out, SEAMS_FILE, force)?;
-        let (_, panels) = dxf_import::placed(&bytes, &source, &options, existing.as_ref().map(|(f, _)| f)).map_err(|e| e.to_string())?;
-        let suggestions = dxf_seams::suggest(&panels).map_err(|e| e.to_string())?;
+        let (_, panels, top) = dxf_import::placed(&bytes, &source, &options, existing.as_ref().map(|(f, _)| f)).map_err(|e| e.to_string())?;
+        let suggestions = dxf_seams::suggest(&panels, top).map_err(|e| e.to_string())?;
         Ok(dxf_seams::suggestions_text(&source, &panels, &suggestions))
     })();
     match result {

@@ -155,7 +155,19 @@ pub fn seams(panels: &[PanelConfig], outlines: &[Outline], a: Stretch, b: Stretc
             // The part's middle says which edge it is on; its ends are measured along it.
             let (edge, _) = outline.locate(stretch.at(0.5 * (s0 + s1)), true);
             let (name, start, length) = &outline.edges[edge];
-            let along = |s: f64| (stretch.at(s) - start).rem_euclid(outline.perimeter).min(*length);
+            // A point of the part lies on the edge up to rounding: one a hair before the
+            // edge's start wraps round the outline and is taken back to the start, one a
+            // hair past its end is its end.
+            let along = |s: f64| {
+                let d = (stretch.at(s) - start).rem_euclid(outline.perimeter);
+                if d <= *length {
+                    d
+                } else if outline.perimeter - d < d - length {
+                    0.0
+                } else {
+                    *length
+                }
+            };
             let (mut p, mut q) = (along(s0), along(s1));
             // A part that ends at its edge's end wraps to 0 there.
             if stretch.counter_clockwise && q < p {
@@ -165,8 +177,11 @@ pub fn seams(panels: &[PanelConfig], outlines: &[Outline], a: Stretch, b: Stretc
                 p = *length;
             }
             let (lo, hi) = if p <= q { (p, q) } else { (q, p) };
-            let whole = lo < 1e-6 && (length - hi) < 1e-6;
-            (format!("{}.{name}", panels[stretch.panel].name), (!whole).then_some([round(lo).max(0.0), round(hi).min(*length)]))
+            // An end within rounding of the edge's end is its end, written in full, so that
+            // no sliver of the edge is left beside the seam.
+            let (lo, hi) = (if lo < SNAP { 0.0 } else { round(lo) }, if length - hi < SNAP { *length } else { round(hi) });
+            let whole = lo == 0.0 && hi == *length;
+            (format!("{}.{name}", panels[stretch.panel].name), (!whole).then_some([lo, hi]))
         };
         let (ka, span_a) = side(a, oa, a0, a1);
         let (kb, span_b) = side(b, ob, b0, b1);
@@ -175,6 +190,9 @@ pub fn seams(panels: &[PanelConfig], outlines: &[Outline], a: Stretch, b: Stretc
     }
     Ok(out)
 }
+
+/// A span end nearer an edge's end than this (garment units: a micrometre in cm) is at it.
+const SNAP: f64 = 1e-4;
 
 /// A span end written to a micrometre (in cm).
 fn round(x: f64) -> f64 {
@@ -224,6 +242,24 @@ placement = {{ around = "plane", angle_deg = 0, distance = 20, height = 100 }}"#
         assert_eq!((sewn[2].a.as_str(), sewn[2].b.as_str()), ("a.e3", "b.e3"));
         assert_eq!(sewn[2].a_span, Some([5.0, 10.0]));
         assert_eq!(sewn[2].b_span, Some([5.0, 10.0]));
+    }
+
+    /// A stretch that ends, going clockwise, exactly where an edge starts (a notch to the
+    /// corner below it) is that edge from its start to the notch, not a stretch of no length
+    /// at the edge's end: the corner's position, one rounding below the edge's start, wraps
+    /// round the outline otherwise.
+    #[test]
+    fn a_stretch_clockwise_to_an_edges_start_keeps_its_length() {
+        let panels = vec![square("a"), square("b")];
+        let outlines: Vec<Outline> = panels.iter().map(|p| Outline::new(p).unwrap()).collect();
+        // a: n1 (15) clockwise to c2 (10), 5 down e2; b: c4 (40) clockwise to 35, on e3.
+        let a = Stretch { panel: 0, from: 15.0, to: 10.0 - 1e-15, counter_clockwise: false };
+        let b = Stretch { panel: 1, from: 40.0, to: 35.0, counter_clockwise: false };
+        let sewn = seams(&panels, &outlines, a, b).unwrap();
+        assert_eq!(sewn.len(), 1, "{sewn:?}");
+        assert_eq!((sewn[0].a.as_str(), sewn[0].a_span), ("a.e2", Some([0.0, 5.0])));
+        assert_eq!((sewn[0].b.as_str(), sewn[0].b_span), ("b.e3", Some([5.0, 10.0])));
+        assert_eq!(sewn[0].direction, Direction::Same);
     }
 
     #[test]

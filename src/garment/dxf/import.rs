@@ -2,7 +2,7 @@
 //! one is given, placed around the form, its hem found (docs/garments.md, "Patterns from
 //! pattern CAD").
 
-use super::panels::{self, Arrangement, PiecePanel};
+use super::panels::{self, Arrangement, PiecePanel, Top};
 use super::seams::{SeamsFile, resolve};
 use super::{DxfPattern, ReadOptions, read};
 use crate::garment::form::FormConfig;
@@ -41,9 +41,9 @@ pub const ORIGIN: Origin<'static> = Origin {
 /// `garment.seam_ease` to (a sleeve cap eased into its armhole is a few per cent).
 const MAX_EASE: f64 = 0.2;
 
-/// The pattern read and its panels placed around the form, the seams file's placement
-/// taken in; what `rosette pattern seams` suggests from.
-pub fn placed(bytes: &[u8], source: &str, options: &ImportOptions, seams: Option<&SeamsFile>) -> Result<(DxfPattern, Vec<PiecePanel>), GarmentError> {
+/// The pattern read and its panels placed around the form with their tops at the level
+/// returned, the seams file's placement taken in; what `rosette pattern seams` suggests from.
+pub fn placed(bytes: &[u8], source: &str, options: &ImportOptions, seams: Option<&SeamsFile>) -> Result<(DxfPattern, Vec<PiecePanel>, Top), GarmentError> {
     let bad = |m: String| GarmentError::new(format!("{source}: {m}"));
     let pattern = read(bytes, source, &options.read)?;
     let mut arrangement = options.arrangement.clone();
@@ -56,14 +56,15 @@ pub fn placed(bytes: &[u8], source: &str, options: &ImportOptions, seams: Option
         .measurements(Units::Cm)
         .map_err(|e| bad(e.message))?
         .ok_or_else(|| bad("the pieces are placed around a generated form: give a form size, not an OBJ body".into()))?;
-    panels::arrange(&mut pieces, &measurements, panels::top(&pattern, &arrangement));
-    Ok((pattern, pieces))
+    let top = panels::top(&pattern, &arrangement);
+    panels::arrange(&mut pieces, &measurements, top);
+    Ok((pattern, pieces, top))
 }
 
 /// Reads a pattern file's bytes (from `source`) and, where given, its seams file (its
 /// text and where it came from) into a garment section in centimetres.
 pub fn import(bytes: &[u8], source: &str, options: &ImportOptions, seams_file: Option<(&SeamsFile, &str)>) -> Result<Imported, GarmentError> {
-    let (pattern, mut pieces) = placed(bytes, source, options, seams_file.map(|s| s.0))?;
+    let (pattern, mut pieces, _) = placed(bytes, source, options, seams_file.map(|s| s.0))?;
     let mut notes = pattern.notes.clone();
     notes.push(format!("read in {}{}", pattern.units.name(), pattern.style.as_ref().map_or(String::new(), |s| format!("; style '{s}'"))));
     for piece in &pattern.pieces {

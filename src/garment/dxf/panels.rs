@@ -537,11 +537,12 @@ mod tests {
         outline.rotate_left(2);
         let found = corners(&outline);
         assert_eq!(found.len(), 4, "{found:?}");
-        // A notch 100 mm up the right side from (400, 0): the outline starts at (300, 600),
-        // so that is its perimeter less the bottom, less the right side's length, plus 100.
+        // A notch 100 mm up the right side from (400, 0): the outline starts at (300, 600)
+        // and ends with the right side, so that is its perimeter less the right side's
+        // length, plus 100.
         let right = DVec2::new(400.0, 0.0).distance(DVec2::new(300.0, 600.0));
         let perimeter = arcs(&outline)[outline.len()];
-        let at = perimeter - 400.0 - right + 100.0;
+        let at = perimeter - right + 100.0;
         let panels = piece_panels(&piece(outline, vec![at], 2), Role::Back);
         assert_eq!(panels.len(), 2);
         let (drawn, mirror) = (&panels[0].panel, &panels[1].panel);

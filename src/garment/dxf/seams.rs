@@ -172,17 +172,24 @@ struct Edge {
     notches: Vec<f64>,
 }
 
+/// How near its panel's highest point both ends of an edge lie for it to be the panel's
+/// top (a waist, a neckline, a shoulder), garment units (cm).
+const TOP_BAND: f64 = 3.0;
+
 /// Edges to pair: sides of different panels whose lengths agree within 2 % (or 5 mm),
 /// whose notches lie at the same distances from the ends joined (within 5 mm or 2 %), that
-/// are neither at the garment's bottom (a hem) nor both ends at its top (a waist or a
-/// neckline), paired nearest first by where the panels start around the form. `panels`
-/// are placed ([`super::panels::arrange`]).
-pub fn suggest(panels: &[PiecePanel]) -> Result<Vec<Suggestion>, GarmentError> {
+/// are neither at the garment's bottom (a hem) nor at a panel's top (a waist or a neckline;
+/// where the tops go to the shoulders, a front's top may pair with a back's, a shoulder
+/// seam), paired nearest first by where the panels start around the form. `panels` are
+/// placed ([`super::panels::arrange`]) with their tops at `top`.
+pub fn suggest(panels: &[PiecePanel], top: Top) -> Result<Vec<Suggestion>, GarmentError> {
     let configs: Vec<&PanelConfig> = panels.iter().map(|p| &p.panel).collect();
     let mut edges = Vec::new();
     // Each edge's placed points, 11 along it, cm.
     let mut placed: Vec<Vec<DVec3>> = Vec::new();
     let (mut lowest, mut highest) = (f64::INFINITY, f64::NEG_INFINITY);
+    // Each panel's highest placed point, cm.
+    let mut tops = vec![f64::NEG_INFINITY; configs.len()];
     for (p, panel) in configs.iter().enumerate() {
         let curves = panel.curves(1.0)?;
         let (lo, hi) = crate::garment::flat::bounds(&curves.iter().flat_map(|c| c.points.iter().copied()).collect::<Vec<_>>());
@@ -194,23 +201,27 @@ pub fn suggest(panels: &[PiecePanel]) -> Result<Vec<Suggestion>, GarmentError> {
             for q in &points {
                 lowest = lowest.min(q.z);
                 highest = highest.max(q.z);
+                tops[p] = tops[p].max(q.z);
             }
             placed.push(points);
             let notches = positions.iter().filter(|(edge, _)| *edge == e).map(|(_, at)| *at).collect();
             edges.push(Edge { panel: p, edge: e, length: curve.length(), notches });
         }
     }
-    let free = |k: usize| {
-        let ends = [placed[k][0].z, placed[k][10].z];
-        let hem = ends.iter().all(|&z| z < lowest + 3.0);
-        let top = ends.iter().all(|&z| z > highest - 1.0);
-        !(hem || top)
+    let ends = |k: usize| [placed[k][0].z, placed[k][10].z];
+    let hem = |k: usize| ends(k).iter().all(|&z| z < lowest + 3.0);
+    let at_top = |k: usize| ends(k).iter().all(|&z| z > highest - 1.0 || z > tops[edges[k].panel] - TOP_BAND);
+    // A shoulder seam: the tops of a front and a back, where the tops go to the shoulders.
+    let shoulder = |i: usize, j: usize| {
+        let roles = [panels[edges[i].panel].role, panels[edges[j].panel].role];
+        top == Top::Shoulder && roles.contains(&Role::Front) && roles.contains(&Role::Back)
     };
+    let pairable = |i: usize, j: usize| !hem(i) && !hem(j) && (!(at_top(i) || at_top(j)) || (at_top(i) && at_top(j) && shoulder(i, j)));
     let mut candidates: Vec<(f64, usize, usize, bool)> = Vec::new();
     for i in 0..edges.len() {
         for j in i + 1..edges.len() {
             let (a, b) = (&edges[i], &edges[j]);
-            if a.panel == b.panel || !free(i) || !free(j) {
+            if a.panel == b.panel || !pairable(i, j) {
                 continue;
             }
             let tolerance = (0.02 * a.length.max(b.length)).max(0.5);
