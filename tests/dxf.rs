@@ -90,9 +90,10 @@ fn valentina_astm_export_reads_as_the_drafted_skirt() {
         assert!(p.sew_line && p.grain_given);
         assert!((p.grain_deg - 90.0).abs() < 1e-6, "{}: {}", p.name, p.grain_deg);
         let [lo, mean, hi] = p.seam_allowance.unwrap();
-        // Valentina's allowance is 10 mm along the edges; at a corner its cut line is cut
-        // off square, so no point of the sew line lies nearer than 10 mm.
-        assert!((lo - 10.0).abs() < 0.05 && (mean - 10.0).abs() < 0.5 && hi < 15.0, "{}: {lo} {mean} {hi}", p.name);
+        // Valentina's allowance is 10 mm; the cut line's curves are flattened apart from
+        // the sew line's, so a sew line point lies up to their chords' sag (a few tenths of
+        // a millimetre) nearer, and at a corner the cut line is cut off square, further.
+        assert!(lo > 9.5 && (mean - 10.0).abs() < 0.2 && hi < 15.0, "{}: {lo} {mean} {hi}", p.name);
         assert_eq!(p.notches.len(), 2, "{}", p.name);
     }
     // Front: x from FHemL (0) to FHemR (68 cm); back: BCW (80) to BSHem (114).
@@ -185,9 +186,12 @@ fn suggested_seams_are_printed_never_applied() {
     assert_eq!(code, Some(0), "{err}");
     let file = parse_seams(&out, "suggested").unwrap();
     assert_eq!(file.seams.len(), 3, "{out}");
-    let pairs: Vec<(String, String)> = file.seams.iter().map(|s| (s.a.piece.clone(), s.b.piece.clone())).collect();
-    assert!(pairs.contains(&("back-right".into(), "back-left".into())), "{pairs:?}");
-    assert_eq!(pairs.iter().filter(|(a, b)| a.starts_with("back") && b == "front").count(), 2, "{pairs:?}");
+    let mut pairs: Vec<[String; 2]> = file.seams.iter().map(|s| [s.a.piece.clone(), s.b.piece.clone()]).collect();
+    for pair in &mut pairs {
+        pair.sort();
+    }
+    pairs.sort();
+    assert_eq!(pairs, [["back-left", "back-right"], ["back-left", "front"], ["back-right", "front"]].map(|p| p.map(String::from)));
     let bytes = std::fs::read(&pattern).unwrap();
     let imported = import(&bytes, "aline-skirt-aama.dxf", &ImportOptions::default(), None).unwrap();
     assert!(imported.garment.seams.is_empty());
@@ -209,7 +213,9 @@ fn export_round_trip_keeps_outline_grain_notches_and_allowance() {
         assert_eq!(again.pieces.len(), garment.panels.len());
         for (panel, p) in garment.panels.iter().zip(&again.pieces) {
             assert_eq!(p.name, panel.name);
-            assert!((p.grain_deg - panel.grain_deg).abs() < 1e-6, "{}: {} against {}", p.name, p.grain_deg, panel.grain_deg);
+            // Coordinates are written to a micrometre (a millionth of an inch): the grain
+            // line's direction to a ten-thousandth of a degree.
+            assert!((p.grain_deg - panel.grain_deg).abs() < 1e-4, "{}: {} against {}", p.name, p.grain_deg, panel.grain_deg);
             let [lo, _, _] = p.seam_allowance.unwrap();
             assert!((lo - 10.0 * panel.seam_allowance.unwrap()).abs() < 0.01, "{}: {lo}", p.name);
             let before = Outline::new(panel).unwrap();
@@ -241,7 +247,10 @@ fn our_export_reads_in_the_dxf_crate_as_the_convention_says() {
     let inserts: Vec<String> = drawing.entities().filter_map(|e| if let EntityType::Insert(i) = &e.specific { Some(i.name.clone()) } else { None }).collect();
     assert_eq!(inserts, ["BACK-RIGHT", "BACK-LEFT", "FRONT"]);
     for block in blocks {
-        let on = |layer: &str| block.entities.iter().filter(move |e| e.common.layer == layer);
+        fn on<'a>(block: &'a dxf::Block, layer: &'a str) -> impl Iterator<Item = &'a dxf::entities::Entity> + 'a {
+            block.entities.iter().filter(move |e| e.common.layer == layer)
+        }
+        let on = |layer: &'static str| on(block, layer);
         let closed: Vec<bool> = on("1").chain(on("14")).filter_map(|e| if let EntityType::Polyline(p) = &e.specific { Some(p.is_closed()) } else { None }).collect();
         assert_eq!(closed, [true, true], "{}", block.name);
         assert_eq!(on("7").filter(|e| matches!(e.specific, EntityType::Line(_))).count(), 1, "{}", block.name);

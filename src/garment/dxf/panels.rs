@@ -300,10 +300,10 @@ pub fn panels(pattern: &DxfPattern, arrangement: &Arrangement) -> Result<Vec<Pie
     Ok(all)
 }
 
-/// A panel's width at its top (within 3 cm of it) and overall, cm.
-fn widths(panel: &PanelConfig) -> (f64, f64) {
+/// The least and greatest x of a panel's outline within 3 cm of its top, cm.
+fn top_span(panel: &PanelConfig) -> (f64, f64) {
     let outline = outline_of(panel);
-    let (lo, hi) = bounds(&outline);
+    let (_, hi) = bounds(&outline);
     // The outline's points, with points every centimetre along its segments, near the top.
     let mut top_lo = f64::INFINITY;
     let mut top_hi = f64::NEG_INFINITY;
@@ -318,7 +318,13 @@ fn widths(panel: &PanelConfig) -> (f64, f64) {
             }
         }
     }
-    (top_hi - top_lo, hi.x - lo.x)
+    (top_lo, top_hi)
+}
+
+/// A panel's width overall, cm.
+fn width(panel: &PanelConfig) -> f64 {
+    let (lo, hi) = bounds(&outline_of(panel));
+    hi.x - lo.x
 }
 
 /// A panel's outline's corners and polyline points, cm.
@@ -379,7 +385,7 @@ fn arrange_plane(panels: &mut [PiecePanel], role: Role, angle: f64, distance: f6
         if !two_sided {
             members.sort_by_key(|&i| panels[i].mirrored);
         }
-        let widths: Vec<f64> = members.iter().map(|&i| widths(&panels[i].panel).1).collect();
+        let widths: Vec<f64> = members.iter().map(|&i| width(&panels[i].panel)).collect();
         let total: f64 = widths.iter().sum::<f64>() + GAP * (widths.len() - 1) as f64;
         // Seen from outside a plane facing out at `plane_angle`, the panel's +x runs
         // counter-clockwise around the form: at the front that is towards the wearer's left,
@@ -430,17 +436,30 @@ fn arrange_ring(panels: &mut [PiecePanel], m: &Measurements) {
         order.extend(of(Role::Side, Some(false)));
         order
     };
-    let sizes: Vec<(f64, f64, f64)> = ring
+    // Each panel's reach to either side of its anchor (the middle of its bounding box),
+    // at its top and overall, and its height, cm: a piece whose top is not centred over
+    // its widest (a half back with a straight centre back and a flared side) reaches
+    // further to one side at the waist than at the hem.
+    struct Reach {
+        top: [f64; 2],
+        overall: [f64; 2],
+        height: f64,
+    }
+    let reaches: Vec<Reach> = ring
         .iter()
         .map(|&i| {
-            let (top, overall) = widths(&panels[i].panel);
+            let (top_lo, top_hi) = top_span(&panels[i].panel);
             let (lo, hi) = bounds(&outline_of(&panels[i].panel));
-            (top, overall, hi.y - lo.y)
+            let centre = 0.5 * (lo.x + hi.x);
+            Reach { top: [centre - top_lo, top_hi - centre], overall: [centre - lo.x, hi.x - centre], height: hi.y - lo.y }
         })
         .collect();
-    let top_total: f64 = sizes.iter().map(|s| s.0).sum();
-    let overall_total: f64 = sizes.iter().map(|s| s.1).sum();
-    let length = sizes.iter().map(|s| s.2).fold(1.0, f64::max);
+    let top_total: f64 = reaches.iter().map(|r| r.top[0] + r.top[1]).sum();
+    let overall_total: f64 = reaches.iter().map(|r| r.overall[0] + r.overall[1]).sum();
+    let length = reaches.iter().map(|r| r.height).fold(1.0, f64::max);
+    // Each panel's share of the circle to either side of its anchor: its top on the waist
+    // circle, its widest on the hem's circle.
+    let shares_at = |radius: f64, hem_radius: f64| -> Vec<[f64; 2]> { reaches.iter().map(|r| [0, 1].map(|k| (r.top[k] / radius).max(r.overall[k] / hem_radius))).collect() };
     // The cone: its radius at the waist clears the form by 4 cm and takes the pieces' tops
     // with room; its flare opens the tops to the pieces' widths over their length, and
     // clears the hips by 2 cm.
@@ -450,29 +469,29 @@ fn arrange_ring(panels: &mut [PiecePanel], m: &Measurements) {
         let develop = ((overall_total - top_total) / (std::f64::consts::TAU * length)).clamp(0.0, 0.95).asin();
         let clear = ((hip_r + 2.0 - radius) / hip_drop).max(0.0).atan();
         flare = develop.max(clear).min(80f64.to_radians());
-        // Each panel's share of the circle: its top on the waist circle, its widest on the
-        // hem's circle; they must leave room between them.
-        let hem_radius = radius + length * flare.sin();
-        let used: f64 = sizes.iter().map(|s| (s.0 / radius).max(s.1 / hem_radius)).sum();
+        // The panels must leave room between them.
+        let used: f64 = shares_at(radius, radius + length * flare.sin()).iter().map(|s| s[0] + s[1]).sum();
         if used <= 0.85 * std::f64::consts::TAU {
             break;
         }
         radius *= 1.1;
     }
-    let hem_radius = radius + length * flare.sin();
-    let shares: Vec<f64> = sizes.iter().map(|s| (s.0 / radius).max(s.1 / hem_radius)).collect();
-    let gap = (std::f64::consts::TAU - shares.iter().sum::<f64>()) / shares.len().max(1) as f64;
+    let shares = shares_at(radius, radius + length * flare.sin());
+    let gap = (std::f64::consts::TAU - shares.iter().map(|s| s[0] + s[1]).sum::<f64>()) / shares.len().max(1) as f64;
     let mut angle = 0.0;
     let mut centres = Vec::with_capacity(ring.len());
     for share in &shares {
-        centres.push(angle + 0.5 * share);
-        angle += share + gap;
+        centres.push(angle + share[0]);
+        angle += share[0] + share[1] + gap;
     }
     // Turn the ring so that the front's middle (or, without a front, the back's) faces its
     // side of the form.
     let front: Vec<usize> = (0..ring.len()).filter(|&k| panels[ring[k]].role == Role::Front).collect();
     let (group, target) = if front.is_empty() { ((0..ring.len()).filter(|&k| panels[ring[k]].role == Role::Back).collect(), 90f64) } else { (front, 270f64) };
-    let middle = if group.is_empty() { 0.0 } else { 0.5 * (centres[group[0]] - 0.5 * shares[group[0]] + centres[*group.last().unwrap()] + 0.5 * shares[*group.last().unwrap()]) };
+    let middle = match (group.first(), group.last()) {
+        (Some(&first), Some(&last)) => 0.5 * (centres[first] - shares[first][0] + centres[last] + shares[last][1]),
+        _ => 0.0,
+    };
     let turn = target.to_radians() - middle;
     for (k, &i) in ring.iter().enumerate() {
         let panel = &mut panels[i].panel;
