@@ -494,4 +494,48 @@ mod tests {
         let grains: Vec<f64> = after.config.garment.as_ref().unwrap().panels.iter().map(|p| p.grain_deg).collect();
         assert_eq!(grains, view.grains);
     }
+
+    /// Sewing by clicks on a DXF pattern imported without seams: the front's side from its
+    /// waist corner to its hem corner, then the back's, makes one seam of two sides drafted
+    /// equal (62.0 cm), which *Sew* hands to the running scene and *Save scene* writes; the
+    /// same stretches clicked again are refused, being sewn already.
+    #[test]
+    fn clicks_on_two_outlines_sew_them_into_the_scene() {
+        use crate::app::worker::Worker;
+        use std::time::Duration;
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/patterns/aline-skirt-aama.dxf");
+        let (config, _) = crate::scene::load_scene(path, &["mesh.edge_length=0.05".into()]).unwrap();
+        assert!(config.garment.as_ref().unwrap().seams.is_empty());
+        let worker = Worker::spawn("aline-skirt-aama", config, None).unwrap();
+        let snapshot = worker.sync(Duration::from_secs(120));
+        let mut view = PatternView { open: true, sewing: true, ..PatternView::default() };
+        view.follow(snapshot.config.garment.as_ref().unwrap(), snapshot.scene_generation);
+        let Some(Ok(flat)) = view.flat.clone() else { panic!("no flat pattern: {:?}", view.flat) };
+        let point = |panel: &str, name: &str| {
+            let p = flat.panels.iter().find(|p| p.name == panel).unwrap();
+            p.points.iter().find(|q| q.0 == name).unwrap().2
+        };
+        let clicks = [("front", "c3"), ("front", "c2"), ("back-left", "c3"), ("back-left", "c2")];
+        for (panel, name) in clicks {
+            view.click(point(panel, name), 1e-3, &snapshot).unwrap();
+        }
+        assert_eq!(view.added(), 1);
+        let note = view.note.clone().unwrap();
+        assert!(note.contains("front 62.0 cm to back-left 62.0 cm, difference 0.0 cm"), "{note}");
+        for (k, (panel, name)) in clicks.into_iter().enumerate() {
+            let result = view.click(point(panel, name), 1e-3, &snapshot);
+            assert_eq!(result.is_err(), k == 3, "{result:?}");
+        }
+        assert_eq!(view.added(), 1);
+        let mut actions = Vec::new();
+        view.sew(&snapshot, &mut actions);
+        let Some(Action::Send(command)) = actions.into_iter().next() else { panic!("no command") };
+        worker.send(command);
+        let after = worker.sync(Duration::from_secs(120));
+        assert!(after.scene_generation > snapshot.scene_generation && after.error.is_none(), "{:?}", after.error);
+        let seams = &after.config.garment.as_ref().unwrap().seams;
+        assert_eq!((seams.len(), seams[0].a.as_str(), seams[0].b.as_str()), (1, "front.e2", "back-left.e3"));
+        let saved = crate::app::files::scene_toml(&after.config).unwrap();
+        assert!(saved.contains("front.e2") && saved.contains("back-left.e3"), "{saved}");
+    }
 }
