@@ -473,32 +473,8 @@ fn piece(source: &Source, mm: f64, options: &ReadOptions, notes: &mut Vec<String
         Some(Ok(line)) => line,
     };
     check_outline(&cut_line, "cut line (layer 1)").map_err(at)?;
-    let cut_area = signed_area(&cut_line);
-    // The sew line: layer 14, else (older AAMA files) a closed layer-8 line inside the cut
-    // line that encloses most of it.
     let eight = layer("8");
-    let mut sew_from_eight = false;
-    let sew_line = match closed_line(&layer("14")) {
-        Some(Ok(line)) => Some(line),
-        Some(Err((end, start))) => {
-            return Err(at(format!(
-                "its sew line (layer 14) does not close: it ends {:.1} mm from where it starts at ({:.1}, {:.1}) mm; close it in the CAD and export it again",
-                end.distance(start),
-                start.x,
-                start.y
-            )));
-        }
-        None => {
-            let candidate = eight
-                .iter()
-                .filter(|(p, c)| p.len() >= 3 && (*c || p[0].distance(*p.last().unwrap()) <= JOIN))
-                .map(|(p, _)| tidy(p))
-                .filter(|p| signed_area(p) > 0.5 * cut_area && p.iter().all(|&q| inside(&cut_line, q, 0.5)))
-                .max_by(|a, b| signed_area(a).total_cmp(&signed_area(b)));
-            sew_from_eight = candidate.is_some();
-            candidate
-        }
-    };
+    let (sew_line, sew_from_eight) = sew_line(&cut_line, &layer("14"), &eight).map_err(at)?;
     let internal_lines = layer("11").len() + eight.len() - usize::from(sew_from_eight);
     if let Some(line) = &sew_line {
         check_outline(line, "sew line").map_err(at)?;
@@ -564,6 +540,31 @@ fn piece(source: &Source, mm: f64, options: &ReadOptions, notes: &mut Vec<String
         drill_holes,
         internal_lines,
     })
+}
+
+/// A piece's sew line: a closed line on layer 14, else (older AAMA files) a closed layer-8
+/// line inside the cut line that encloses most of it, said by the flag; None without one.
+fn sew_line(cut_line: &[DVec2], fourteen: &[(&Vec<DVec2>, bool)], eight: &[(&Vec<DVec2>, bool)]) -> Result<(Option<Vec<DVec2>>, bool), String> {
+    let cut_area = signed_area(cut_line);
+    match closed_line(fourteen) {
+        Some(Ok(line)) => Ok((Some(line), false)),
+        Some(Err((end, start))) => Err(format!(
+            "its sew line (layer 14) does not close: it ends {:.1} mm from where it starts at ({:.1}, {:.1}) mm; close it in the CAD and export it again",
+            end.distance(start),
+            start.x,
+            start.y
+        )),
+        None => {
+            let candidate = eight
+                .iter()
+                .filter(|(p, c)| p.len() >= 3 && (*c || p[0].distance(*p.last().unwrap()) <= JOIN))
+                .map(|(p, _)| tidy(p))
+                .filter(|p| signed_area(p) > 0.5 * cut_area && p.iter().all(|&q| inside(cut_line, q, 0.5)))
+                .max_by(|a, b| signed_area(a).total_cmp(&signed_area(b)));
+            let from_eight = candidate.is_some();
+            Ok((candidate, from_eight))
+        }
+    }
 }
 
 /// Refuses an outline with too many points or no area.
