@@ -132,7 +132,7 @@ impl ViewerUi {
         egui::CentralPanel::no_frame().show(ui, |ui| self.view(ui, snapshot, &mut actions));
         self.chart.show(ui.ctx());
         self.card.show(ui.ctx(), self.fabric.as_ref());
-        self.pattern.show(ui.ctx(), snapshot);
+        self.pattern.show(ui.ctx(), snapshot, &mut actions);
         self.flush_fabric(&mut actions);
         actions
     }

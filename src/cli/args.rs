@@ -265,27 +265,92 @@ pub const DEFAULT_MAX_WALL: f64 = 86_400.0;
 
 #[derive(Subcommand)]
 pub enum PatternAction {
-    /// Convert a GarmentCode pattern specification (JSON: panels, their 3D placement,
-    /// stitches) into a garment scene file to run, view and edit (docs/garments.md).
+    /// Convert a pattern into a garment scene file to run, view and edit
+    /// (docs/garments.md): GarmentCode's specification (JSON: panels, their 3D placement,
+    /// stitches) or pattern CAD's DXF (AAMA / ASTM D6673: pieces with cut and sew lines,
+    /// grain lines, notches), sewn by its seams file.
     Import {
-        /// The specification file (GarmentCode's `*_specification.json`).
+        /// The pattern: GarmentCode's `*_specification.json` or a `.dxf` from pattern CAD.
         spec: std::path::PathBuf,
         /// Write the scene file here (default: standard output).
         #[arg(long, value_name = "FILE.toml")]
         out: Option<std::path::PathBuf>,
-        /// The form's bundled size (uk-10, uk-12, uk-14).
-        #[arg(long, default_value = "uk-14")]
-        form: String,
+        #[command(flatten)]
+        pattern: PatternArgs,
         /// The fabric (a bundled name, see `rosette fabric list`).
-        #[arg(long, default_value = rosette::garment::garmentcode::DEFAULT_FABRIC)]
+        #[arg(long, default_value = rosette::garment::import::DEFAULT_FABRIC)]
         fabric: String,
-        /// The warp's angle in each panel as drafted, degrees from its x axis: 90 runs it
-        /// up and down the panel (straight grain), 45 or 135 cuts every panel on the bias.
-        #[arg(long, default_value_t = 90.0, allow_hyphen_values = true)]
-        grain_deg: f64,
+        /// DXF: the seams file (default: NAME.seams.toml beside NAME.dxf, where there is one).
+        #[arg(long, value_name = "FILE.toml")]
+        seams: Option<std::path::PathBuf>,
         /// Replace an existing file that is not Rosette's own output of the same kind (an
         /// input of the command is never overwritten).
         #[arg(long)]
         force: bool,
     },
+    /// Suggest seams for a DXF pattern: edges of the pieces that match in length and
+    /// notches, paired by where the pieces go around the form, written as a seams file for
+    /// the designer to check and keep (nothing is sewn that the file does not say).
+    Seams {
+        /// The pattern (`.dxf`).
+        pattern: std::path::PathBuf,
+        /// Write the suggested seams file here (default: standard output).
+        #[arg(long, value_name = "FILE.toml")]
+        out: Option<std::path::PathBuf>,
+        #[command(flatten)]
+        options: PatternArgs,
+        /// Replace an existing file that is not Rosette's own output of the same kind.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Write a garment's panels as a DXF pattern in the AAMA / ASTM D6673 convention (R12):
+    /// outline (cut and sew lines), grain line, notches, names and units, for pattern CAD.
+    Export {
+        /// A garment scene: a bundled name, a scene file or a pattern (`.json`, `.dxf`).
+        scene: String,
+        /// The DXF file to write.
+        #[arg(long, value_name = "FILE.dxf")]
+        out: std::path::PathBuf,
+        /// Override a scene value, e.g. --set garment.panels[0].grain_deg=45 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<String>,
+        /// The file's unit: mm (`Units: METRIC`) or in (`Units: ENGLISH`).
+        #[arg(long, default_value = "mm")]
+        units: String,
+        /// Notches as AAMA's short lines instead of ASTM's points.
+        #[arg(long)]
+        aama: bool,
+        /// Replace an existing file that is not Rosette's own output of the same kind.
+        #[arg(long)]
+        force: bool,
+    },
+}
+
+/// How a pattern is read and placed (`pattern import`, `pattern seams`).
+#[derive(clap::Args, Clone)]
+pub struct PatternArgs {
+    /// The form's bundled size (uk-10, uk-12, uk-14).
+    #[arg(long, default_value = "uk-14")]
+    pub form: String,
+    /// GarmentCode: the warp's angle in each panel as drafted, degrees from its x axis (90,
+    /// the default, runs it up and down the panel; 45 or 135 cuts every panel on the bias).
+    /// DXF: the angle for pieces that have no grain line (refused without it).
+    #[arg(long, allow_hyphen_values = true)]
+    pub grain_deg: Option<f64>,
+    /// DXF: the file's unit (mm, cm or in), whatever it says.
+    #[arg(long)]
+    pub units: Option<String>,
+    /// DXF: a piece that goes to the form's front, whatever its name (repeatable).
+    #[arg(long, value_name = "PIECE")]
+    pub front: Vec<String>,
+    /// DXF: a piece that goes to the form's back (repeatable).
+    #[arg(long, value_name = "PIECE")]
+    pub back: Vec<String>,
+    /// DXF: a piece that goes to the arms' side (repeatable).
+    #[arg(long, value_name = "PIECE")]
+    pub sleeve: Vec<String>,
+    /// DXF: where the pieces' tops go: waist (skirts, trousers) or shoulder (tops,
+    /// dresses); default from the pieces' names.
+    #[arg(long)]
+    pub top: Option<String>,
 }

@@ -57,9 +57,11 @@ pub fn dispatch(cli: Cli) -> ExitCode {
             FabricAction::Check { fabric } => fabric::check(&fabric),
             FabricAction::Export { fabric, arcsim: _, out, force } => super::arcsim::export(&fabric, out.as_deref(), force),
         },
-        Some(Command::Pattern { action: PatternAction::Import { spec, out, form, fabric, grain_deg, force } }) => {
-            super::pattern::import(&spec, out.as_deref(), &form, &fabric, grain_deg, force)
-        }
+        Some(Command::Pattern { action }) => match action {
+            PatternAction::Import { spec, out, pattern, fabric, seams, force } => super::pattern::import(&spec, out.as_deref(), &pattern, &fabric, seams.as_deref(), force),
+            PatternAction::Seams { pattern, out, options, force } => super::pattern::seams(&pattern, out.as_deref(), &options, force),
+            PatternAction::Export { scene, out, overrides, units, aama, force } => super::pattern::export(&scene, &out, &overrides, &units, aama, force),
+        },
         Some(Command::Run { preset, mut overrides, duration, metrics, outline, step_log, max_steps, max_wall, fast, plan, export, export_frames, force, screenshot }) => {
             if fast {
                 overrides.push(SolverPath::Fast.setting());

@@ -24,6 +24,8 @@ pub const BENCH_CSV: Kind = Kind { noun: "a benchmark table", signature: Signatu
 pub const BENCH_JSON: Kind = Kind { noun: "a benchmark's numbers", signature: Signature::Starts("[\n  {\n    \"case\": ") };
 pub const ARCSIM_FILE: Kind = Kind { noun: "an ARCSim material", signature: Signature::Starts("// ARCSim material of ") };
 pub const PATTERN_SCENE: Kind = Kind { noun: "an imported garment scene", signature: Signature::SecondLine("# Written by `rosette pattern import") };
+pub const SEAMS_FILE: Kind = Kind { noun: "a suggested seams file", signature: Signature::Starts("# Seams suggested for ") };
+pub const DXF_PATTERN: Kind = Kind { noun: "a DXF pattern", signature: Signature::Starts(rosette::garment::dxf::write::FIRST_LINES) };
 pub const FABRIC_FILE: Kind = Kind { noun: "a fabric file", signature: Signature::SecondLine("# Written by `rosette fabric import") };
 
 /// The files a command read (scenes, fabrics, sheets, through `rosette::io::read`), with

@@ -4,7 +4,8 @@
 //! window. Built from the `[garment]` section alone (no meshing), so it follows the grain
 //! being edited before the garment is recut.
 
-use super::pattern::Polyline;
+use super::pattern::{Polyline, Units};
+use super::stretch::Outline;
 use super::{GarmentConfig, GarmentError, check_names, seams};
 use glam::DVec2;
 
@@ -43,6 +44,12 @@ pub struct FlatPanel {
     pub centre: DVec2,
     /// Width and height of the bounding box.
     pub size: DVec2,
+    /// Its named points (corners `cK` of a DXF import's edges `eK`, notches), each with its
+    /// distance along the outline from its start (garment units) and where it is drawn.
+    pub points: Vec<(String, f64, DVec2)>,
+    /// Distance along the outline (garment units) at each point of `outline`, and at its
+    /// end (the perimeter) last.
+    pub arc: Vec<f64>,
 }
 
 /// One seam's two stretches, laid out, each from its start to its end along its edge;
@@ -51,12 +58,26 @@ pub struct FlatPanel {
 pub struct FlatSeam {
     pub a: Vec<DVec2>,
     pub b: Vec<DVec2>,
+    /// The two stretches' lengths, in the garment's units.
+    pub lengths: [f64; 2],
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlatPattern {
     pub panels: Vec<FlatPanel>,
     pub seams: Vec<FlatSeam>,
+    /// The unit of the lengths along outlines and seams.
+    pub units: Units,
+}
+
+/// The point `at` along a closed outline (garment units, `arc` its distances).
+pub fn along(outline: &[DVec2], arc: &[f64], at: f64) -> DVec2 {
+    let perimeter = *arc.last().unwrap_or(&0.0);
+    let at = if perimeter > 0.0 { at.rem_euclid(perimeter) } else { 0.0 };
+    let i = arc.partition_point(|&a| a <= at).clamp(1, outline.len()) - 1;
+    let (a0, a1) = (arc[i], arc[i + 1]);
+    let t = if a1 > a0 { (at - a0) / (a1 - a0) } else { 0.0 };
+    outline[i].lerp(outline[(i + 1) % outline.len()], t)
 }
 
 /// Points sampled along each seam stretch.
@@ -82,9 +103,21 @@ impl FlatPattern {
                 let outline: Vec<DVec2> = outline.iter().map(|&p| p + shift).collect();
                 let (lo, hi) = bounds(&outline);
                 let grain = grains_deg.and_then(|g| g.get(i).copied()).unwrap_or(panel.grain_deg).to_radians();
-                FlatPanel { name: panel.name.clone(), outline, grain, centre: 0.5 * (lo + hi), size: hi - lo }
+                let mut arc = vec![0.0];
+                for k in 0..outline.len() {
+                    arc.push(arc[k] + outline[k].distance(outline[(k + 1) % outline.len()]) / metres);
+                }
+                let named = Outline::new(panel).map(|o| o.point_names(panel)).unwrap_or_default();
+                let points = named
+                    .into_iter()
+                    .map(|(name, at)| {
+                        let position = along(&outline, &arc, at);
+                        (name, at, position)
+                    })
+                    .collect();
+                FlatPanel { name: panel.name.clone(), outline, grain, centre: 0.5 * (lo + hi), size: hi - lo, points, arc }
             })
-            .collect();
+            .collect::<Vec<FlatPanel>>();
         let mut flat_seams = Vec::with_capacity(config.seams.len());
         for (i, s) in config.seams.iter().enumerate() {
             let key = format!("garment.seams[{i}]");
@@ -99,9 +132,13 @@ impl FlatPattern {
             if s.direction == seams::Direction::Opposite {
                 b.reverse();
             }
-            flat_seams.push(FlatSeam { a, b });
+            let length = |text: &str, span: Option<[f64; 2]>| -> Result<f64, GarmentError> {
+                let (p, e) = seams::resolve(&key, text, &names)?;
+                Ok(span.map_or(curves[p][e].length() / metres, |[from, to]| to - from))
+            };
+            flat_seams.push(FlatSeam { a, b, lengths: [length(&s.a, s.a_span)?, length(&s.b, s.b_span)?] });
         }
-        Ok(Self { panels, seams: flat_seams })
+        Ok(Self { panels, seams: flat_seams, units: config.units })
     }
 
     /// Lower left and upper right corners of everything drawn.

@@ -24,9 +24,9 @@
 
 use super::GarmentError;
 use super::form::FormConfig;
-use super::pattern::{Around, EdgeConfig, PanelConfig, PlacementConfig, Units};
+use super::import::{Imported, Origin, garment, hem_edges, hem_note};
+use super::pattern::{Around, EdgeConfig, PanelConfig, PlacementConfig};
 use super::seams::{Direction, SeamConfig};
-use super::GarmentConfig;
 use glam::{DMat3, DVec2, DVec3};
 use serde::Deserialize;
 use serde_json::Value;
@@ -105,13 +105,6 @@ struct SpecEdge {
     curvature: Option<Value>,
 }
 
-/// What an import gives: the garment section, and what the reader chose for the user to
-/// know (the hem it took, units assumed).
-pub struct Imported {
-    pub garment: GarmentConfig,
-    pub notes: Vec<String>,
-}
-
 /// Options of an import.
 pub struct ImportOptions {
     /// The form the garment goes on.
@@ -124,34 +117,16 @@ pub struct ImportOptions {
 impl Default for ImportOptions {
     /// The largest bundled form and the straight grain.
     fn default() -> Self {
-        Self { form: FormConfig { size: Some("uk-14".into()), ..FormConfig::default() }, grain_deg: 90.0 }
+        Self { form: super::import::default_form(), grain_deg: 90.0 }
     }
 }
 
-/// The fabric an imported garment is made of unless one is named.
-pub const DEFAULT_FABRIC: &str = "cotton-shirting";
-
-/// The scene file of an imported garment named `name`, read from `source`, in `fabric`.
-pub fn scene_text(imported: &Imported, source: &str, name: &str, fabric: &str) -> Result<String, GarmentError> {
-    #[derive(serde::Serialize)]
-    struct Section<'a> {
-        garment: &'a GarmentConfig,
-    }
-    let garment = toml::to_string(&Section { garment: &imported.garment })
-        .map_err(|e| GarmentError::new(format!("{source}: the garment cannot be written as TOML ({e})")))?;
-    let name = name.replace(['"', '\\', '\n', '\r'], "'");
-    let fabric = fabric.replace(['"', '\\', '\n', '\r'], "'");
-    let (panels, seams) = (imported.garment.panels.len(), imported.garment.seams.len());
-    Ok(format!(
-        "# {name}: a garment imported from GarmentCode's pattern specification {}\n\
-         # Written by `rosette pattern import` ({panels} panels, {seams} seams). Lengths in [garment] are in cm;\n\
-         # each panel starts where GarmentCode places it, on a vertical plane facing out. Every other\n\
-         # setting is a garment's (presets/bases/garment.toml in the repository).\n\
-         base = \"garment\"\n\n\
-         [scene]\ndescription = \"{name} ({panels} panels, from GarmentCode) in {fabric}\"\n\n[fabric]\npreset = \"{fabric}\"\n\n{garment}",
-        source.replace(['\n', '\r'], " "),
-    ))
-}
+/// Where the panels of a GarmentCode import come from, for the scene file's header.
+pub const ORIGIN: Origin<'static> = Origin {
+    format: "GarmentCode's pattern specification",
+    short: "GarmentCode",
+    placement: "each panel starts where GarmentCode places it, on a vertical plane facing out.",
+};
 
 /// Reads a GarmentCode specification (`text`, from `source`) into a `[garment]` section
 /// in centimetres.
@@ -235,23 +210,9 @@ pub fn import(text: &str, source: &str, options: &ImportOptions) -> Result<Impor
     if !eased.is_empty() {
         notes.push(format!("garment.seam_ease = {ease}: GarmentCode gathers {}", eased.join(", ")));
     }
-    let hem = hem_edges(&order, &panels, &heights, &stitched);
-    notes.push(if hem.is_empty() { "no free edge at the garment's bottom: no hem".into() } else { format!("hem: {}", hem.join(", ")) });
-    let garment = GarmentConfig {
-        units: Units::Cm,
-        form: options.form.clone(),
-        panels,
-        seams,
-        attachments: Vec::new(),
-        hem,
-        seam_ease: ease,
-        sewing_stiffness: super::default_sewing_stiffness(),
-        sewing_ramp: super::default_sewing_ramp(),
-        sewing_damping: super::default_sewing_damping(),
-        sewing_time: super::default_sewing_time(),
-        closed_share: super::default_closed_share(),
-    };
-    Ok(Imported { garment, notes })
+    let hem = hem_edges(&panels, &heights, &stitched);
+    notes.push(hem_note(&hem));
+    Ok(Imported { garment: garment(options.form.clone(), panels, seams, hem, ease), notes })
 }
 
 /// A stitch's two sides, each as (panel, edge) by index.
@@ -291,22 +252,6 @@ fn stitches(stitches: &[Vec<Value>], order: &[String], panels: &[PanelConfig]) -
         seams.push(SeamConfig { a: key(a), b: key(b), direction, a_span: None, b_span: None });
     }
     Ok((seams, sides))
-}
-
-/// The hem: the free edges (in no stitch) at the garment's bottom, both ends (`heights`,
-/// cm, by panel and edge) within HEM_BAND of its lowest point, as `panel.edge`.
-fn hem_edges(order: &[String], panels: &[PanelConfig], heights: &[Vec<[f64; 2]>], stitched: &[Vec<usize>]) -> Vec<String> {
-    const HEM_BAND: f64 = 3.0;
-    let lowest = heights.iter().flatten().flatten().copied().fold(f64::INFINITY, f64::min);
-    let mut hem = Vec::new();
-    for (p, edges) in heights.iter().enumerate() {
-        for (e, ends) in edges.iter().enumerate() {
-            if !stitched[p].contains(&e) && ends.iter().all(|&z| z < lowest + HEM_BAND) {
-                hem.push(format!("{}.{}", order[p], panels[p].edges[e].name));
-            }
-        }
-    }
-    hem
 }
 
 /// The largest relative difference between a seam's sides that an import sets
@@ -406,6 +351,7 @@ fn convert_panel(name: &str, panel: &SpecPanel, relative: bool, to_cm: f64, grai
             to: plane(end).to_array(),
             through: through.map(|t| plane(t).to_array()),
             controls: controls.map(|[a, b]| [plane(a).to_array(), plane(b).to_array()]),
+            points: None,
         });
         edge_heights.push([height(plane(start)), height(plane(end))]);
     }
@@ -417,6 +363,8 @@ fn convert_panel(name: &str, panel: &SpecPanel, relative: bool, to_cm: f64, grai
         edges,
         anchor: Some(anchor.to_array()),
         placement,
+        notches: Vec::new(),
+        seam_allowance: None,
     };
     Ok((panel, edge_heights))
 }

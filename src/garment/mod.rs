@@ -11,13 +11,16 @@
 //!
 //! This module builds the pattern and the form (`Garment`); `scene::garment` runs them.
 
+pub mod dxf;
 pub mod flat;
 pub mod form;
 pub mod garmentcode;
+pub mod import;
 pub mod mesh;
 pub mod pattern;
 pub mod place;
 pub mod seams;
+pub mod stretch;
 
 use crate::sim::model::PanelSurface;
 use glam::{DVec2, DVec3};
@@ -82,7 +85,7 @@ pub struct GarmentConfig {
     pub closed_share: f64,
 }
 
-fn default_seam_ease() -> f64 {
+pub(crate) fn default_seam_ease() -> f64 {
     0.05
 }
 fn default_sewing_stiffness() -> f64 {
@@ -164,6 +167,17 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
         }
         let edge_names: Vec<&str> = panel.edges.iter().map(|e| e.name.as_str()).collect();
         pattern::check_simple(&panel.name, &edge_names, &c)?;
+        panel.notch_positions(&c, metres)?;
+        if let Some(allowance) = panel.seam_allowance
+            && !(allowance.is_finite() && allowance >= 0.0 && allowance * metres <= MAX_SEAM_ALLOWANCE)
+        {
+            return Err(GarmentError::new(format!(
+                "garment.panels '{}': seam_allowance = {allowance} must be a width between 0 and {} {} (it is kept for export, not sewn)",
+                panel.name,
+                MAX_SEAM_ALLOWANCE / metres,
+                config.units.name()
+            )));
+        }
         curves.push(c);
     }
     // Refinement leaves triangles of about (√3/4) h²: refuse a mesh past the vertex cap
@@ -276,6 +290,10 @@ fn check_placement(panel: &PanelConfig, units: Units) -> Result<(), GarmentError
     }
     Ok(())
 }
+
+/// The widest seam allowance a piece may carry, m: hems are turned up by a few centimetres,
+/// never by a tenth of a metre.
+const MAX_SEAM_ALLOWANCE: f64 = 0.1;
 
 /// How far from the form's axis, and above or below its floor point, a placed panel may
 /// start, m. A designer arranges panels around the body; a panel metres away (an anchor or

@@ -35,7 +35,8 @@ impl Units {
 }
 
 /// One edge of an outline, from the end of the previous edge (or the panel's `start`) to
-/// `to`: straight, an arc through `through`, or a cubic Bézier with `controls`.
+/// `to`: straight, an arc through `through`, a cubic Bézier with `controls`, or a polyline
+/// through `points` (a curve as pattern CAD exports it, already flattened).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EdgeConfig {
@@ -49,6 +50,22 @@ pub struct EdgeConfig {
     /// A cubic Bézier curve with these two control points.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub controls: Option<[[f64; 2]; 2]>,
+    /// A polyline through these points, in order, between the edge's start and `to`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 2]>>,
+}
+
+/// A notch: the pattern maker's matching mark, a named point on an edge. Seams files and
+/// the flat pattern name it; it does not change the cloth.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NotchConfig {
+    /// Unique within the panel (a DXF import numbers them n1, n2, ... around the outline).
+    pub name: String,
+    /// The edge it lies on.
+    pub edge: String,
+    /// Distance along the edge from its start, in the garment's units.
+    pub at: f64,
 }
 
 /// How a panel starts around the form (the arrangement point of CLO and Marvelous).
@@ -99,6 +116,14 @@ pub struct PanelConfig {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anchor: Option<[f64; 2]>,
     pub placement: PlacementConfig,
+    /// Notches on the outline's edges.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notches: Vec<NotchConfig>,
+    /// The seam allowance the piece is cut with, in the garment's units: the width between
+    /// its cut line and this outline, which is its sew line. A fact of the piece, kept for
+    /// `rosette pattern export`; the cloth simulated is the outline alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seam_allowance: Option<f64>,
 }
 
 impl PanelConfig {
@@ -166,8 +191,19 @@ impl PanelConfig {
             let key = format!("edge '{}'", e.name);
             let to = point(name, &format!("{key}: to"), e.to, metres)?;
             let points = match (e.through, e.controls) {
+                _ if e.points.is_some() && (e.through.is_some() || e.controls.is_some()) => {
+                    return Err(GarmentError::new(format!("garment.panels '{name}': {key} gives `points` (a polyline) with `through` or `controls`; keep one")));
+                }
                 (Some(_), Some(_)) => {
                     return Err(GarmentError::new(format!("garment.panels '{name}': {key} gives both `through` (an arc) and `controls` (a Bézier curve); keep one")));
+                }
+                (None, None) if e.points.is_some() => {
+                    let mut points = vec![from];
+                    for &p in e.points.as_deref().unwrap_or_default() {
+                        points.push(point(name, &format!("{key}: points"), p, metres)?);
+                    }
+                    points.push(to);
+                    points
                 }
                 (Some(through), None) => arc_through(from, point(name, &format!("{key}: through"), through, metres)?, to)
                     .ok_or_else(|| GarmentError::new(format!("garment.panels '{name}': {key}: the arc's three points lie on a line; drop `through` for a straight edge")))?,
@@ -189,6 +225,38 @@ impl PanelConfig {
             )));
         }
         Ok(curves)
+    }
+}
+
+impl PanelConfig {
+    /// Each notch resolved to its edge (by index) and its distance along it (m), or an
+    /// error naming the panel and the notch. `curves` are the panel's edges sampled in
+    /// metres ([`PanelConfig::curves`]).
+    pub fn notch_positions(&self, curves: &[Polyline], metres: f64) -> Result<Vec<(usize, f64)>, GarmentError> {
+        let name = &self.name;
+        let mut positions = Vec::with_capacity(self.notches.len());
+        for (i, notch) in self.notches.iter().enumerate() {
+            let key = format!("garment.panels '{name}': notch '{}'", notch.name);
+            if self.notches[..i].iter().any(|n| n.name == notch.name) {
+                return Err(GarmentError::new(format!("garment.panels '{name}': two notches are named '{}'; give each its own name", notch.name)));
+            }
+            let edge = self.edges.iter().position(|e| e.name == notch.edge).ok_or_else(|| {
+                let edges: Vec<&str> = self.edges.iter().map(|e| e.name.as_str()).collect();
+                GarmentError::new(format!("{key}: no edge '{}'; the edges are {}", notch.edge, edges.join(", ")))
+            })?;
+            let length = curves[edge].length();
+            let at = notch.at * metres;
+            if !(at.is_finite() && (-1e-9..=length + 1e-9).contains(&at)) {
+                return Err(GarmentError::new(format!(
+                    "{key}: at = {} must lie on edge '{}', between 0 and its length {:.4} (garment units)",
+                    notch.at,
+                    notch.edge,
+                    length / metres
+                )));
+            }
+            positions.push((edge, at.clamp(0.0, length)));
+        }
+        Ok(positions)
     }
 }
 

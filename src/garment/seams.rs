@@ -97,6 +97,10 @@ pub fn side(key: &str, (panel, edge): (usize, usize), span: Option<[f64; 2]>, le
 /// `edge_length`. `lengths[p][e]` is the length of edge e of panel p (m).
 pub fn cuts(lengths: &[Vec<f64>], seams: &[(Side, Side)], counts: &[usize], edge_length: f64, names: &[(String, Vec<String>)]) -> Result<Vec<Vec<Cuts>>, GarmentError> {
     let parts = |length: f64| ((length / edge_length).round() as usize).max(1);
+    // A gap between stretches, or a rest of an edge after its last stretch, shorter than
+    // this is rounding in the pattern (a span written to a micrometre), not cloth: a vertex
+    // there would make a triangle of no area.
+    let tiny = 1e-3 * edge_length;
     let mut all = Vec::with_capacity(lengths.len());
     for (p, edges) in lengths.iter().enumerate() {
         let mut panel_cuts = Vec::with_capacity(edges.len());
@@ -122,14 +126,16 @@ pub fn cuts(lengths: &[Vec<f64>], seams: &[(Side, Side)], counts: &[usize], edge
                     return Err(GarmentError::new(format!("{which}; give each side its own stretch with a_span / b_span")));
                 }
                 last = Some(i);
-                if from > at + 1e-9 {
+                if from > at + tiny {
                     cut.extend(even_cuts(at, from - at, parts(from - at)).into_iter().skip(1));
                 }
                 cut.extend(even_cuts(from, to - from, n).into_iter().skip(1));
                 at = to;
             }
-            if length > at + 1e-9 {
+            if length > at + tiny {
                 cut.extend(even_cuts(at, length - at, parts(length - at)).into_iter().skip(1));
+            } else if let Some(last) = cut.last_mut() {
+                *last = length;
             }
             panel_cuts.push(cut);
         }

@@ -30,6 +30,11 @@ pub enum FileKind {
     Script,
     /// A fabric's texture: a PNG or JPEG image (`[appearance] texture`).
     Image,
+    /// A sewing pattern from pattern CAD: DXF in the AAMA / ASTM D6673 convention, read as
+    /// bytes (its text may be in a Windows code page, or the file binary DXF, refused).
+    Dxf,
+    /// The seams of a DXF pattern (TOML).
+    Seams,
 }
 
 impl FileKind {
@@ -38,7 +43,7 @@ impl FileKind {
     /// of the largest prop contact resolves well (a million triangles) is about 60 MB.
     pub fn limit(self) -> u64 {
         match self {
-            FileKind::Scene | FileKind::Fabric | FileKind::Script => 1 << 20,
+            FileKind::Scene | FileKind::Fabric | FileKind::Script | FileKind::Seams => 1 << 20,
             FileKind::Obj => 128 << 20,
             FileKind::Csv => 16 << 20,
             // A material is under 2 kB; its comments may be long.
@@ -49,6 +54,9 @@ impl FileKind {
             // a PNG of noise; past that it is not a texture (the decoded size has its own
             // bound, `appearance::texture::MAX_SIDE`).
             FileKind::Image => 64 << 20,
+            // A pattern of two pieces exported by Valentina is 30 to 60 kB; a graded style of
+            // thirty pieces in every size a few MB.
+            FileKind::Dxf => 16 << 20,
         }
     }
 
@@ -63,6 +71,8 @@ impl FileKind {
             FileKind::Pattern => "pattern in GarmentCode's JSON format",
             FileKind::Script => "viewer script",
             FileKind::Image => "texture image (PNG or JPEG)",
+            FileKind::Dxf => "pattern file (DXF)",
+            FileKind::Seams => "seams file",
         }
     }
 
@@ -70,7 +80,8 @@ impl FileKind {
     /// contents are not quoted in messages (see [`quotable`]).
     pub fn extension(self) -> &'static str {
         match self {
-            FileKind::Scene | FileKind::Fabric | FileKind::Script => "toml",
+            FileKind::Scene | FileKind::Fabric | FileKind::Script | FileKind::Seams => "toml",
+            FileKind::Dxf => "dxf",
             FileKind::Obj => "obj",
             FileKind::Csv => "csv",
             FileKind::Arcsim | FileKind::Pattern => "json",
@@ -196,8 +207,8 @@ pub fn read_text(path: &Path, kind: FileKind) -> Result<String, ReadError> {
     String::from_utf8(bytes).map_err(|_| ReadError::NotText { path: path.display().to_string(), noun: kind.noun() })
 }
 
-/// Reads the regular file at `path` as bytes of `kind` (an image), with the checks of
-/// [`read_text`] but for the text's. The file is remembered for the output guard.
+/// Reads the regular file at `path` as bytes of `kind`, with the checks of [`read_text`]
+/// but its text's encoding; the file is remembered for the output guard.
 pub fn read_bytes(path: &Path, kind: FileKind) -> Result<Vec<u8>, ReadError> {
     let shown = path.display().to_string();
     let io = |e: std::io::Error| ReadError::Io { path: shown.clone(), message: e.to_string() };

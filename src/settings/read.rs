@@ -31,10 +31,21 @@ pub fn is_arcsim_file(spec: &str) -> bool {
     Path::new(spec).extension().is_some_and(|e| e.eq_ignore_ascii_case("json"))
 }
 
-/// Whether the scene `spec` names a sewing pattern (GarmentCode's `….json`), which stands
-/// for the scene `rosette pattern import` writes for it.
+/// Whether `spec` names a pattern CAD file (`….dxf`).
+pub fn is_dxf_file(spec: &str) -> bool {
+    Path::new(spec).extension().is_some_and(|e| e.eq_ignore_ascii_case("dxf"))
+}
+
+/// Whether the scene `spec` names a sewing pattern (GarmentCode's `….json`, pattern CAD's
+/// `….dxf`), which stands for the scene `rosette pattern import` writes for it.
 pub fn is_pattern_spec(spec: &str) -> bool {
-    is_arcsim_file(spec)
+    is_arcsim_file(spec) || is_dxf_file(spec)
+}
+
+/// The seams file that goes with a pattern file: `NAME.seams.toml` beside `NAME.dxf`.
+pub fn seams_beside(pattern: &Path) -> PathBuf {
+    let stem = pattern.file_stem().map_or_else(|| "pattern".into(), |s| s.to_string_lossy().into_owned());
+    pattern.with_file_name(format!("{stem}.seams.toml"))
 }
 
 /// A scene table with the bundled base it names (`base = "garment"`) laid under it: the
@@ -120,7 +131,7 @@ pub fn read_preset(kind: PresetKind, spec: &str, base: Option<&Path>, key: Optio
     }
     let json = is_arcsim_file(spec);
     let arcsim = kind == PresetKind::Fabric && json;
-    if !path.exists() && !looks_like_path(spec) && !json {
+    if !path.exists() && !looks_like_path(spec) && !json && !is_dxf_file(spec) {
         let available = list.iter().map(|b| b.name).collect::<Vec<_>>().join(", ");
         return Err(PresetError::Unknown { kind: kind.name(), name: spec.to_string(), available });
     }
@@ -131,6 +142,9 @@ pub fn read_preset(kind: PresetKind, spec: &str, base: Option<&Path>, key: Optio
     }
     if kind == PresetKind::Scene && json {
         return garment_pattern_table(&path, &file, key).map(|table| (table, file));
+    }
+    if kind == PresetKind::Scene && is_dxf_file(spec) {
+        return dxf_pattern_table(&path, &file, key).map(|table| (table, file));
     }
     let text = read_text(&path, kind.file_kind()).map_err(|source| PresetError::Read { key, source })?;
     let mut table = parse_toml(&text, Some(&path), kind.file_kind()).map_err(|message| PresetError::Syntax { file: file.clone(), message })?;
@@ -147,16 +161,42 @@ pub fn read_preset(kind: PresetKind, spec: &str, base: Option<&Path>, key: Optio
 /// The scene table a GarmentCode pattern specification (`….json`) stands for: the scene
 /// `rosette pattern import` would write for it with its defaults (docs/garments.md).
 fn garment_pattern_table(path: &Path, file: &str, key: Option<&'static str>) -> Result<toml::Table, PresetError> {
-    use crate::garment::garmentcode::{DEFAULT_FABRIC, ImportOptions, import, scene_text};
+    use crate::garment::garmentcode::{ImportOptions, ORIGIN, import};
     let text = read_text(path, FileKind::Pattern).map_err(|source| PresetError::Read { key, source })?;
-    // The reader's messages start with the file's name, which `Invalid` gives.
-    let invalid = |e: crate::garment::GarmentError| {
-        let message = e.message.strip_prefix(&format!("{file}: ")).map_or(e.message.clone(), str::to_string);
-        PresetError::Invalid { file: file.to_string(), message }
+    let imported = import(&text, file, &ImportOptions::default()).map_err(|e| pattern_invalid(file, e))?;
+    imported_table(&imported, &ORIGIN, path, file)
+}
+
+/// The scene table a pattern CAD file (`….dxf`) stands for: the scene `rosette pattern
+/// import` would write for it with its defaults, sewn by the seams file beside it
+/// (`NAME.seams.toml`) where there is one.
+fn dxf_pattern_table(path: &Path, file: &str, key: Option<&'static str>) -> Result<toml::Table, PresetError> {
+    use crate::garment::dxf::import::{ImportOptions, ORIGIN, import};
+    let bytes = crate::io::read::read_bytes(path, FileKind::Dxf).map_err(|source| PresetError::Read { key, source })?;
+    let seams_path = seams_beside(path);
+    let seams = if seams_path.is_file() {
+        let shown = seams_path.display().to_string();
+        let text = read_text(&seams_path, FileKind::Seams).map_err(|source| PresetError::Read { key, source })?;
+        let parsed = crate::garment::dxf::seams::parse(&text, &shown).map_err(|e| pattern_invalid(&shown, e))?;
+        Some((parsed, shown))
+    } else {
+        None
     };
-    let imported = import(&text, file, &ImportOptions::default()).map_err(invalid)?;
+    let imported = import(&bytes, file, &ImportOptions::default(), seams.as_ref().map(|(f, s)| (f, s.as_str()))).map_err(|e| pattern_invalid(file, e))?;
+    imported_table(&imported, &ORIGIN, path, file)
+}
+
+/// A reader's message as a refusal of `file`: the reader starts it with the file's name,
+/// which `Invalid` gives.
+fn pattern_invalid(file: &str, e: crate::garment::GarmentError) -> PresetError {
+    let message = e.message.strip_prefix(&format!("{file}: ")).map_or(e.message.clone(), str::to_string);
+    PresetError::Invalid { file: file.to_string(), message }
+}
+
+/// The scene table of an imported pattern, in the default fabric.
+fn imported_table(imported: &crate::garment::import::Imported, origin: &crate::garment::import::Origin, path: &Path, file: &str) -> Result<toml::Table, PresetError> {
     let name = path.file_stem().map_or_else(|| "pattern".into(), |s| s.to_string_lossy().into_owned());
-    let scene = scene_text(&imported, file, &name, DEFAULT_FABRIC).map_err(invalid)?;
+    let scene = crate::garment::import::scene_text(imported, origin, file, &name, crate::garment::import::DEFAULT_FABRIC).map_err(|e| pattern_invalid(file, e))?;
     parse_table(&scene, file)
 }
 
