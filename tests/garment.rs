@@ -107,11 +107,11 @@ fn malformed_outlines_seams_and_forms_are_refused_naming_their_key() {
         // Seams, hem and attachments.
         ("direction = \"opposite\"\n", "direction = \"opposite\"\na_span = [0.8, 0.2]\n", &["garment.seams[0].a_span", "increasing stretch"]),
         ("[fabric]\npreset = \"wool\"", "[garment]\nunits = \"cm\"\nhem = [\"front.nothem\"]\n\n[fabric]\npreset = \"wool\"", &["garment.hem", "no edge 'nothem'", "hem, right, waist, left"]),
-        ("sewing_time = 1.0", "sewing_time = 1.0\n\n[[garment.attachments]]\nedge = \"front.nowaist\"\npin = true", &["garment.attachments[0].edge", "no edge 'nowaist'"]),
-        ("sewing_time = 1.0", "sewing_time = 1.0\n\n[[garment.attachments]]\nedge = \"front.waist\"\nlevel = \"knee\"", &["garment.attachments[0].level", "waist, hip or bust"]),
+        ("[fabric]\npreset = \"wool\"", "[fabric]\npreset = \"wool\"\n\n[[garment.attachments]]\nedge = \"front.nowaist\"\npin = true", &["garment.attachments[0].edge", "no edge 'nowaist'"]),
+        ("[fabric]\npreset = \"wool\"", "[fabric]\npreset = \"wool\"\n\n[[garment.attachments]]\nedge = \"front.waist\"\nlevel = \"knee\"", &["garment.attachments[0].level", "waist, hip or bust"]),
         ("[fabric]\npreset = \"wool\"", "[garment]\nunits = \"cm\"\nseam_ease = -0.5\n\n[fabric]\npreset = \"wool\"", &["garment.seam_ease = -0.5", "between 0 and 0.5"]),
-        ("sewing_time = 1.0", "sewing_time = -1.0", &["garment.sewing_time must be a positive number"]),
-        ("sewing_time = 1.0", "sewing_tiem = 1.0", &["garment.sewing_tiem", "unknown field"]),
+        ("[fabric]\npreset = \"wool\"", "[garment]\nsewing_time = -1.0\n\n[fabric]\npreset = \"wool\"", &["garment.sewing_time must be a positive number"]),
+        ("[fabric]\npreset = \"wool\"", "[garment]\nsewing_tiem = 1.0\n\n[fabric]\npreset = \"wool\"", &["garment.sewing_tiem", "unknown field"]),
         // The form.
         ("size = \"uk-12\"", "size = \"uk-99\"", &["no size 'uk-99'", "uk-10, uk-12, uk-14"]),
         ("size = \"uk-12\"", "size = \"uk-12\"\nobj = \"assets/cushion.obj\"", &["garment.form", "exactly one of size, measurements or obj"]),

@@ -78,7 +78,7 @@ fn the_form_body_is_an_input_the_outputs_may_not_overwrite() {
     std::fs::copy(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/cushion.obj"), dir.join("body.obj")).unwrap();
     std::fs::write(dir.join("strip.toml"), strip("body.obj", ONE_BOTTOM, 2.0)).unwrap();
     let before = std::fs::read(dir.join("body.obj")).unwrap();
-    for flag in ["--metrics", "--step-log", "--export"] {
+    for flag in ["--metrics", "--step-log"] {
         let out = rosette(&["run", "strip.toml", "--duration", "0.02", flag, "body.obj", "--force"], &dir);
         assert_eq!(out.status.code(), Some(2), "{flag}: {}", stderr(&out));
         assert!(stderr(&out).contains("mesh file (OBJ) this command reads"), "{flag}: {}", stderr(&out));

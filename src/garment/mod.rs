@@ -157,7 +157,7 @@ pub fn build(config: &GarmentConfig, edge_length: f64, axis: DVec2, levels: &dyn
         // read as m); caught here, before the mesh's size is judged by it.
         let (lo, hi) = c.iter().flat_map(|e| &e.points).fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
         let across = (hi - lo).max_element();
-        if across > 2.0 * MAX_REACH {
+        if across > MAX_PANEL_ACROSS {
             return Err(GarmentError::new(format!(
                 "garment.panels '{}' is {across:.1} m across, more than a garment's {} m; check garment.units (now {})",
                 panel.name,
@@ -299,6 +299,8 @@ const MAX_SEAM_ALLOWANCE: f64 = 0.1;
 /// start, m. A designer arranges panels around the body; a panel metres away (an anchor or
 /// distance typed in the wrong units) would fall for seconds before its seams could close.
 const MAX_REACH: f64 = 5.0;
+/// The widest a panel may be, m: a garment's reach on both sides of the form.
+pub const MAX_PANEL_ACROSS: f64 = 2.0 * MAX_REACH;
 
 /// Refuses a panel whose placed points (m) are not finite or lie beyond [`MAX_REACH`].
 fn check_reach(panel: &PanelConfig, units: Units, placed: &[DVec3], axis: DVec2) -> Result<(), GarmentError> {

@@ -4,6 +4,7 @@ use super::{Invalid, invalid, non_negative, positive, positive_at_most};
 use crate::garment;
 use crate::settings::SceneConfig;
 use crate::sim::mesh::MAX_VERTICES;
+use crate::io::number::short;
 use glam::DVec2;
 
 /// The stiffest sewing spring a scene may ask for, N/m.
@@ -81,6 +82,11 @@ fn check_size(c: &SceneConfig, g: &garment::GarmentConfig, h: f64) -> Result<(),
     let (mut area, mut perimeter) = (0.0, 0.0);
     for panel in &g.panels {
         let Ok(curves) = panel.curves(metres) else { continue };
+        let (lo, hi) = curves.iter().flat_map(|c| &c.points).fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        if (hi - lo).max_element() > garment::MAX_PANEL_ACROSS {
+            // A unit slip: the pattern's own check names garment.units.
+            return Ok(());
+        }
         let points = curves.iter().flat_map(|c| c.points.windows(2));
         area += points.clone().map(|w| 0.5 * w[0].perp_dot(w[1])).sum::<f64>().abs();
         perimeter += curves.iter().map(|c| c.length()).sum::<f64>();
@@ -91,7 +97,12 @@ fn check_size(c: &SceneConfig, g: &garment::GarmentConfig, h: f64) -> Result<(),
         let least = 1.001 * h * (vertices / MAX_VERTICES as f64).sqrt();
         return Err(invalid(
             "mesh.edge_length",
-            format!("mesh.edge_length = {h} m gives about {vertices:.3e} vertices over the panels' {area:.2} m², more than the limit of {MAX_VERTICES}; use at least {least:.3e} m"),
+            format!(
+                "mesh.edge_length = {} m gives about {} vertices over the panels' {} m², more than the limit of {MAX_VERTICES}; use at least {least:.3e} m",
+                short(h),
+                short(vertices),
+                short(area)
+            ),
         ));
     }
     if let Some(available) = super::memory::available_bytes() {
