@@ -145,7 +145,7 @@ pub fn glb(name: &str, frames: &[ClothFrame], look: &Look) -> Result<Vec<u8>, Ex
             )));
         }
     }
-    if frames.windows(2).any(|w| !(w[1].time > w[0].time)) {
+    if frames.windows(2).any(|w| w[1].time.partial_cmp(&w[0].time) != Some(std::cmp::Ordering::Greater)) {
         return Err(ExportError::Empty("the frames' times do not increase".into()));
     }
     // Runs of frames on one mesh.

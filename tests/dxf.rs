@@ -306,7 +306,10 @@ for block in doc.blocks:
 
 /// A small R12 pattern file: each piece (block name, piece name, its cut line, whether it
 /// closes, a grain line) inserted once, `Units: METRIC`.
-fn pattern_text(pieces: &[(&str, &str, Vec<[f64; 2]>, bool, bool)], extra_lines: usize) -> String {
+/// A piece of [`pattern_text`]: block name, piece name, cut line, closed, with a grain line.
+type PieceSpec<'a> = (&'a str, &'a str, Vec<[f64; 2]>, bool, bool);
+
+fn pattern_text(pieces: &[PieceSpec], extra_lines: usize) -> String {
     let mut t = String::from("0\nSECTION\n2\nHEADER\n9\n$ACADVER\n1\nAC1009\n0\nENDSEC\n0\nSECTION\n2\nBLOCKS\n");
     for (block, name, outline, closed, grain) in pieces {
         t += &format!("0\nBLOCK\n8\n1\n2\n{block}\n70\n0\n10\n0\n20\n0\n30\n0\n3\n{block}\n");
@@ -339,7 +342,9 @@ fn rect(w: f64, h: f64) -> Vec<[f64; 2]> {
 #[test]
 fn bad_pattern_files_are_refused_naming_the_piece() {
     let open = vec![[0.0, 0.0], [200.0, 0.0], [200.0, 400.0], [0.0, 400.0], [0.0, 30.0]];
-    let cases: Vec<(&str, Vec<u8>, Vec<&str>, Vec<&str>)> = vec![
+    // Name, file bytes, flags, words the refusal must hold.
+    type Case<'a> = (&'a str, Vec<u8>, Vec<&'a str>, Vec<&'a str>);
+    let cases: Vec<Case> = vec![
         ("binary", [rosette::garment::dxf::BINARY_SENTINEL, &[0u8; 64][..]].concat(), vec![], vec!["binary DXF", "ASCII"]),
         ("unclosed", pattern_text(&[("YOKE", "Yoke", open, false, true)], 0).into_bytes(), vec![], vec!["piece 'Yoke'", "does not close", "30.0 mm"]),
         ("no-grain", pattern_text(&[("CUFF", "Cuff", rect(200.0, 100.0), true, false)], 0).into_bytes(), vec![], vec!["piece 'Cuff'", "no grain line", "--grain-deg"]),

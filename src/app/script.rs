@@ -240,8 +240,8 @@ impl Script {
     }
 }
 
-/// The action of one step, checked against the scene.
-fn step_action(raw: &RawStep, scene: &SceneConfig, base: Option<&Path>) -> Result<Action, String> {
+/// The one action a step holds, by its key.
+fn action_key(raw: &RawStep) -> Result<&'static str, String> {
     let set: Vec<&str> = [
         ("wait", raw.wait.is_some()),
         ("wait_simulated_s", raw.wait_simulated_s.is_some()),
@@ -270,11 +270,16 @@ fn step_action(raw: &RawStep, scene: &SceneConfig, base: Option<&Path>) -> Resul
     .into_iter()
     .filter_map(|(key, given)| given.then_some(key))
     .collect();
-    let key = match set.as_slice() {
-        [key] => *key,
-        [] => return Err(format!("this step does nothing: give it one action ({ACTION_KEYS})")),
-        several => return Err(format!("this step holds {}: give each action its own [[step]]", several.join(" and "))),
-    };
+    match set.as_slice() {
+        [key] => Ok(*key),
+        [] => Err(format!("this step does nothing: give it one action ({ACTION_KEYS})")),
+        several => Err(format!("this step holds {}: give each action its own [[step]]", several.join(" and "))),
+    }
+}
+
+/// The action of one step, checked against the scene.
+fn step_action(raw: &RawStep, scene: &SceneConfig, base: Option<&Path>) -> Result<Action, String> {
+    let key = action_key(raw)?;
     let is_wait = key.starts_with("wait");
     if raw.timeout_s.is_some() && !is_wait {
         return Err(format!("timeout_s bounds a wait, not {key}: move it to a wait step or drop it"));
@@ -292,7 +297,7 @@ fn step_action(raw: &RawStep, scene: &SceneConfig, base: Option<&Path>) -> Resul
         }
     };
     let seconds = |name: &str, value: f64| -> Result<f64, String> {
-        if value.is_finite() && value >= 0.0 && value <= LONGEST_S {
+        if (0.0..=LONGEST_S).contains(&value) {
             Ok(value)
         } else {
             Err(format!("{name} = {value} must be a number of seconds from 0 to {LONGEST_S}"))
@@ -305,10 +310,9 @@ fn step_action(raw: &RawStep, scene: &SceneConfig, base: Option<&Path>) -> Resul
                 "sewn" => return Err(no_garment("wait = \"sewn\"")),
                 "settled" if scene.scene.settle_speed.is_some() => WaitFor::Settled,
                 "settled" => {
-                    return Err(format!(
-                        "wait = \"settled\": this scene does not watch for settling (its scene.settle_speed is not set): \
-                         wait = \"finished\", wait_simulated_s or wait_wall_s instead"
-                    ))
+                    return Err("wait = \"settled\": this scene does not watch for settling (its scene.settle_speed is not set): \
+                                wait = \"finished\", wait_simulated_s or wait_wall_s instead"
+                        .to_string())
                 }
                 "finished" => WaitFor::Finished,
                 other => return Err(format!("wait = \"{other}\": wait for \"sewn\", \"settled\" or \"finished\" (or use wait_simulated_s, wait_wall_s)")),
@@ -375,6 +379,14 @@ fn step_action(raw: &RawStep, scene: &SceneConfig, base: Option<&Path>) -> Resul
             }
             Action::Test(name)
         }
+        _ => view_action(key, raw, garment.is_some(), &no_garment)?,
+    })
+}
+
+/// A step that acts on the view (drag, orbit, zoom, windows, colour map, screenshot);
+/// `garment`: whether the scene is a garment's, `no_garment` the refusal where it is not.
+fn view_action(key: &str, raw: &RawStep, garment: bool, no_garment: &dyn Fn(&str) -> String) -> Result<Action, String> {
+    Ok(match key {
         "drag" => {
             let drag = raw.drag.as_ref().expect("the key is set");
             let inside = |p: [f64; 2]| p.iter().all(|c| (0.0..=1.0).contains(c));
@@ -408,7 +420,7 @@ fn step_action(raw: &RawStep, scene: &SceneConfig, base: Option<&Path>) -> Resul
             let window = match name {
                 "card" => Window::Card,
                 "chart" => Window::Chart,
-                "pattern" if garment.is_some() => Window::Pattern,
+                "pattern" if garment => Window::Pattern,
                 "pattern" => return Err(no_garment("the flat pattern")),
                 other => return Err(format!("{key} = \"{other}\": the windows are \"card\", \"chart\" and \"pattern\"")),
             };

@@ -127,7 +127,7 @@ pub fn seams(panels: &[PanelConfig], outlines: &[Outline], a: Stretch, b: Stretc
     let (oa, ob) = (&outlines[a.panel], &outlines[b.panel]);
     let (la, lb) = (a.length(oa.perimeter), b.length(ob.perimeter));
     for (s, l, p) in [(a, la, &panels[a.panel]), (b, lb, &panels[b.panel])] {
-        if !(l > SAME_POINT) {
+        if l.partial_cmp(&SAME_POINT) != Some(std::cmp::Ordering::Greater) {
             return Err(GarmentError::new(format!("the stretch of '{}' from {:.1} to {:.1} has no length; pick two different points", p.name, s.from, s.to)));
         }
     }

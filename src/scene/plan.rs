@@ -368,6 +368,17 @@ fn level_with_choices(config: &SceneConfig, edge_length: Option<f64>) -> (SceneC
             );
         }
     }
+    choose_newton_stops(&mut chooser, &mut level, kind, slow);
+    (level, chooser.choices)
+}
+
+/// The plan's choices of when Newton and CG stop: the error share, a garment's deflated
+/// and bounded solves, and the bounded matrix kept through a landing step.
+fn choose_newton_stops(chooser: &mut Chooser<'_>, level: &mut SceneConfig, kind: Design, slow: bool) {
+    let fast = level.solver.fast;
+    let yes_no = |b: bool| b.to_string();
+    let number = |v: f64| crate::io::number::short(v);
+    let count = |v: usize| v.to_string();
     // Garments keep the tighter share: at the motion's, the shift dress settled on 3 hem
     // nodes instead of the exact path's 5 and the circle skirt did not settle in 6 s
     // (docs/performance-log.md).
@@ -410,8 +421,8 @@ fn level_with_choices(config: &SceneConfig, edge_length: Option<f64>) -> (SceneC
             "a landing cloth buckles in most iterations: once the exact matrix fails in a step, the rest of the step takes the bounded one",
         );
     }
-    (level, chooser.choices)
 }
+
 
 #[cfg(test)]
 mod tests {

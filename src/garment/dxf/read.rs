@@ -419,6 +419,13 @@ fn perimeter(points: &[DVec2]) -> f64 {
     (0..points.len()).map(|i| points[i].distance(points[(i + 1) % points.len()])).sum()
 }
 
+/// The seam allowance between a sew line and its cut line: least, mean and most.
+fn allowance_between(sew_line: &[DVec2], cut_line: &[DVec2]) -> [f64; 3] {
+    let distances: Vec<f64> = sew_line.iter().map(|&q| nearest(cut_line, q).1).collect();
+    let mean = distances.iter().sum::<f64>() / distances.len() as f64;
+    [distances.iter().copied().fold(f64::INFINITY, f64::min), mean, distances.iter().copied().fold(0.0, f64::max)]
+}
+
 /// Sorts one piece's shapes by layer into a [`Piece`] in millimetres (`mm` per file unit).
 fn piece(source: &Source, mm: f64, options: &ReadOptions, notes: &mut Vec<String>) -> Result<Piece, String> {
     let block = &source.block;
@@ -493,11 +500,7 @@ fn piece(source: &Source, mm: f64, options: &ReadOptions, notes: &mut Vec<String
             size.x, size.y, mm
         )));
     }
-    let seam_allowance = sew_line.as_ref().map(|line| {
-        let distances: Vec<f64> = line.iter().map(|&q| nearest(&cut_line, q).1).collect();
-        let mean = distances.iter().sum::<f64>() / distances.len() as f64;
-        [distances.iter().copied().fold(f64::INFINITY, f64::min), mean, distances.iter().copied().fold(0.0, f64::max)]
-    });
+    let seam_allowance = sew_line.as_deref().map(|line| allowance_between(line, &cut_line));
     let grain = layer("7")
         .into_iter()
         .filter(|(p, _)| p.len() >= 2)
