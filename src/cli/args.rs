@@ -12,7 +12,8 @@ use rosette::render;
                   4 an output could not be rendered or written after the run (standard output included); 5 the run ended but \
                   some Newton solves did not converge (metrics: converged = false); 6 the run \
                   stopped at --max-steps or --max-wall; 8 a garment's seams were not closed by its \
-                  sewing time. Metrics, outline and picture are kept for 3 to 8."
+                  sewing time; 9 a sewn garment did not end on its form (its drape measures withheld); \
+                  130 or 143 stopped by Ctrl-C or SIGTERM. Metrics, outline and picture are kept for 3 to 9, 130 and 143."
 )]
 pub struct Cli {
     #[command(subcommand)]

@@ -21,7 +21,8 @@ use std::process::ExitCode;
 /// run), 3 the simulation diverged, 4 an output could not be rendered or written after the
 /// run, 5 the run ended but some Newton solves did not converge, 6 the run stopped at its
 /// step or wall-time bound, 7 a fabric's virtual tests disagree with its sheet, 8 a
-/// garment's seams were not closed by its sewing time.
+/// garment's seams were not closed by its sewing time, 9 a sewn garment did not end on its
+/// form; 128 + the signal where Ctrl-C or SIGTERM stopped the run.
 pub const EXIT_BAD_INPUT: u8 = 2;
 pub const EXIT_DIVERGED: u8 = 3;
 pub const EXIT_NO_OUTPUT: u8 = 4;
