@@ -384,6 +384,13 @@ fn a_sewn_garment_re_drapes_in_a_new_fabric_and_grain() {
     assert_eq!(regrained.positions.len(), sewn.positions.len());
     assert_ne!(regrained.topology.version, sewn.topology.version);
     assert_eq!(regrained.topology.merged_from.as_ref().unwrap().0, refabric.topology.version);
+    // An edit the checks refuse (a grain beyond a full turn) is refused with their message,
+    // and the garment goes on as it was.
+    worker.send(Command::SetGrains(vec![1000.0; 4]));
+    let refused = worker.sync(WAIT);
+    let error = refused.error.clone().expect("a grain of 1000° is refused");
+    assert!(error.contains("grains not applied") && error.contains("grain_deg"), "{error}");
+    assert_eq!(refused.topology.version, regrained.topology.version, "the running garment stays");
     worker.send(Command::LoadScene { name: "skirt".into(), config: Box::new(config) });
     worker.send(Command::Step);
     let reloaded = worker.sync(WAIT);

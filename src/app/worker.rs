@@ -266,6 +266,14 @@ pub struct Worker {
     thread: Option<JoinHandle<()>>,
 }
 
+/// Builds a scene the window edited (a fabric, grains, the path, a reset) after the checks
+/// a scene file meets, so that an edit the command line would refuse is refused here too,
+/// with the same message, and the running scene stays.
+fn checked_build(config: SceneConfig) -> Result<Scene, String> {
+    crate::settings::validate::check_scene(&config).map_err(|e| e.message)?;
+    Scene::build(config).map_err(|e| e.to_string())
+}
+
 impl Worker {
     /// Builds `config` and starts the worker thread on it, paused. `name` labels the scene.
     /// `on_publish` is called (on the worker thread) after each publish, e.g. to wake the UI.
@@ -573,7 +581,7 @@ impl WorkerState {
     /// Builds `config` and makes it the running scene, labelled `name` (the old label when
     /// `None`). On failure the current scene stays and the message is returned.
     fn load(&mut self, config: SceneConfig, name: Option<String>, play: bool) -> Result<(), String> {
-        let scene = Scene::build(config).map_err(|e| e.to_string())?;
+        let scene = checked_build(config)?;
         self.scene = scene;
         if let Some(name) = name {
             self.scene_name = name;
@@ -588,7 +596,7 @@ impl WorkerState {
     /// sewn garment whose pattern the edit keeps goes on from where it hangs, anything else
     /// starts from t = 0. The drape plays unless the user had paused.
     fn redrape(&mut self, config: SceneConfig, cause: DrapeCause) -> Result<(), String> {
-        let mut scene = Scene::build(config).map_err(|e| e.to_string())?;
+        let mut scene = checked_build(config)?;
         let from_sewn = scene.continue_sewn(&self.scene);
         let started_at = scene.state.time;
         self.scene = scene;
