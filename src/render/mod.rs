@@ -63,13 +63,15 @@ mod headless;
 mod legend;
 mod renderer;
 mod shadow;
+mod vertex;
 
 pub use camera::Camera;
 pub use colormap::{ColorMap, ScalarField};
 pub use frame::{Frame, PropMesh};
 pub use headless::{Headless, Screenshot, read_back, save_screenshot};
 pub use legend::bar_rect as legend_bar_rect;
-pub use renderer::{DEPTH_FORMAT, Renderer};
+pub use renderer::Renderer;
+pub use vertex::DEPTH_FORMAT;
 
 use thiserror::Error;
 

@@ -3,6 +3,7 @@
 use super::camera::Camera;
 use super::frame::{Frame, PropMesh};
 use super::shadow::{self, ShadowMap};
+use super::vertex::{DEPTH_FORMAT, Vertex};
 use crate::appearance::{Look, Pattern, shade::mean_linear};
 use super::legend::{self, GRADIENT_ROWS, GRADIENT_TEXELS, OverlayVertex};
 use super::{RenderOptions, font};
@@ -10,8 +11,6 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-/// Depth buffer format the renderer draws with (the caller's, for [`Renderer::paint`]).
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Where the key light comes from: high, and to the right of the default view, so folds
 /// and buckles are modelled by light and shade.
@@ -53,17 +52,6 @@ struct Globals {
     shadow_map: [f32; 4],
 }
 
-/// A vertex of the cloth or a prop (buffers are de-indexed: three per triangle).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-pub(super) struct Vertex {
-    pub position: [f32; 3],
-    pub normal: [f32; 3],
-    /// Rest position along warp and weft, m.
-    pub uv: [f32; 2],
-    /// Position on the colour scale 0..1, or −1 for the fabric look.
-    pub scale: f32,
-}
 
 /// A vertex buffer that grows as needed and is rewritten each frame.
 struct GrowingBuffer {

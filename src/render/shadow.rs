@@ -18,7 +18,7 @@
 //! ```
 
 use super::frame::Frame;
-use super::renderer::{DEPTH_FORMAT, Vertex};
+use super::vertex::{DEPTH_FORMAT, Vertex};
 use glam::{Mat4, Vec2, Vec3};
 
 /// The shadow map's side, texels. A garment's shadow on a floor spans about a metre and a
