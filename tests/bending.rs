@@ -12,7 +12,7 @@ fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Measures) {
     let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
     let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
     assert!(error.is_none(), "{error:?}");
-    (config, metrics.measures)
+    (config.into_config(), metrics.measures)
 }
 
 /// B_θ of paper eq. 3 from the fabric's inputs, with θ the bending direction from the warp.
@@ -413,9 +413,9 @@ fn settled_cantilever_stops_early_with_the_same_answer() {
     let (config, _) = load_scene("cantilever", &[]).unwrap();
     let mut settling = Scene::build(config.clone()).unwrap();
     let (early, _) = run_scene(&mut settling, "cantilever", RunOptions::default());
-    let mut full_config = config;
+    let mut full_config = config.into_config();
     full_config.scene.settle_speed = None;
-    let mut full = Scene::build(full_config).unwrap();
+    let mut full = Scene::new(full_config).unwrap();
     let (complete, _) = run_scene(&mut full, "cantilever", RunOptions::default());
     assert_eq!(early.settled, Some(true));
     assert_eq!(complete.settled, None);

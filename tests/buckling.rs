@@ -12,7 +12,7 @@ fn run(preset: &str, overrides: &[&str]) -> (SceneConfig, Measures) {
     let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
     let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
     assert!(error.is_none(), "{error:?}");
-    (config, metrics.measures)
+    (config.into_config(), metrics.measures)
 }
 
 /// Pinned–pinned Euler load π²B/L² per unit width, B the warp rigidity (the strip's axis).

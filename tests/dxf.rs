@@ -408,7 +408,7 @@ fn a_bundled_garment_exports_as_dxf() {
     let (code, _, err, _) = rosette(&["pattern", "export", "skirt-gored-straight", "--out", out.to_str().unwrap()]);
     assert_eq!(code, Some(0), "{err}");
     let (config, _) = rosette::scene::load_scene("skirt-gored-straight", &[]).unwrap();
-    let garment = config.garment.unwrap();
+    let garment = config.into_config().garment.unwrap();
     let again = read(&std::fs::read(&out).unwrap(), "skirt.dxf", &ReadOptions::default()).unwrap();
     assert_eq!(again.pieces.len(), garment.panels.len());
     let metres_to_mm = 1000.0 * garment.units.metres();
@@ -452,7 +452,7 @@ fn any_dxf_file_imports_or_is_refused_cleanly() {
                 assert_eq!(code, Some(0), "{name}: {err}");
                 let (config, _) = rosette::scene::load_scene(out.to_str().unwrap(), &[]).unwrap();
                 let again = read(&std::fs::read(&dxf).unwrap(), &name, &ReadOptions::default()).unwrap();
-                assert_eq!(again.pieces.len(), config.garment.unwrap().panels.len(), "{name}");
+                assert_eq!(again.pieces.len(), config.garment.as_ref().unwrap().panels.len(), "{name}");
                 eprintln!("{name}: imported, exported, read back");
             }
             Some(2) => {

@@ -129,9 +129,8 @@ fn scenes_that_do_not_settle_run_the_same_on_both_paths() {
 /// naming the keys.
 #[test]
 fn the_fast_path_with_an_explicit_integrator_is_refused() {
-    let (config, _) = load_scene("cusick-drape", &["solver.path=fast".into(), "solver.integrator=symplectic-euler".into()]).unwrap();
-    let message = match Scene::build(config) {
-        Ok(_) => panic!("built"),
+    let message = match load_scene("cusick-drape", &["solver.path=fast".into(), "solver.integrator=symplectic-euler".into()]) {
+        Ok(_) => panic!("loaded"),
         Err(e) => e.to_string(),
     };
     assert!(message.contains("solver.path") && message.contains("solver.integrator"), "{message}");
@@ -144,9 +143,9 @@ fn the_fast_path_with_an_explicit_integrator_is_refused() {
 #[test]
 fn a_cloth_in_motion_on_a_ball_takes_the_long_step_and_stays_out_of_it() {
     let overrides: Vec<String> = ["mesh.edge_length=0.04", "scene.duration=0.6", "solver.path=fast"].map(String::from).to_vec();
-    let (mut config, _) = load_scene("sphere-drop", &overrides).unwrap();
+    let mut config = load_scene("sphere-drop", &overrides).unwrap().0.into_config();
     config.scene.settle_speed = None;
-    let mut scene = Scene::build(config.clone()).unwrap();
+    let mut scene = Scene::new(config.clone()).unwrap();
     let (m, error) = run_scene(&mut scene, "sphere-drop", RunOptions::default());
     println!(
         "sphere drop, 4 cm edges, fast, 0.6 s: dt {} s, {} Newton iterations, penetration {:?}, {:.2} s wall",

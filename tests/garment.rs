@@ -12,7 +12,7 @@ use rosette::settings as preset;
 fn load_text(name: &str, text: &str) -> Result<SceneConfig, String> {
     let path = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();
-    load_scene(path.to_str().unwrap(), &[]).map(|(c, _)| c).map_err(|e| e.to_string())
+    load_scene(path.to_str().unwrap(), &[]).map(|(c, _)| c.into_config()).map_err(|e| e.to_string())
 }
 
 fn bundled(name: &str) -> String {
@@ -46,7 +46,7 @@ fn bad_patterns_are_refused_naming_the_panel_and_the_edge() {
     // A panel placed inside the form: refused when the scene is built, before any step.
     let inside = gored.replacen("distance = 17", "distance = 5", 1);
     let config = load_text("inside", &inside).unwrap();
-    let err = Scene::build(config).err().expect("a panel inside the form is refused").to_string();
+    let err = Scene::new(config).err().expect("a panel inside the form is refused").to_string();
     assert!(err.contains("'front'") && err.contains("inside the form"), "{err}");
     // An anchor typed in the wrong units (a panel placed 30 m to the side), and one at
     // infinity: refused naming the panel and the keys to check.
@@ -122,7 +122,7 @@ fn malformed_outlines_seams_and_forms_are_refused_naming_their_key() {
     }
     // A form mesh that is not there: refused when the scene is built, before any step.
     let config = load_text("no-form", &gored.replacen("size = \"uk-12\"", "obj = \"no/such/body.obj\"", 1)).unwrap();
-    let err = Scene::build(config).err().expect("a missing form mesh is refused").to_string();
+    let err = Scene::new(config).err().expect("a missing form mesh is refused").to_string();
     assert!(err.contains("garment.form.obj") && err.contains("no such file"), "{err}");
     // A mesh too fine for memory is refused before meshing, with the edge that fits.
     let err = load_scene("skirt-gored-straight", &["mesh.edge_length=0.00005".into()]).expect_err("too fine").to_string();
@@ -213,7 +213,7 @@ fn a_hanging_panel_stretches_by_its_weight_over_the_modulus_of_its_cut() {
                     let f = &config.fabric.properties;
                     let e = modulus_at(theta, initial_slope(&f.tensile_warp), initial_slope(&f.tensile_weft), f.shear_modulus, f.poisson_warp);
                     let predicted = f.areal_density * g * length * length / (2.0 * e);
-                    let mut scene = Scene::build(config).unwrap();
+                    let mut scene = Scene::new(config).unwrap();
                     let (metrics, error) = run_scene(&mut scene, "hang", RunOptions::default());
                     assert!(error.is_none() && metrics.settled == Some(true), "{error:?} {metrics:?}");
                     // The top and bottom edges by their place on the pattern.
@@ -319,7 +319,7 @@ direction = "opposite"
 #[test]
 fn a_tube_sewn_from_one_rectangle_keeps_no_membrane_strain() {
     let config = load_text("tube", TUBE).unwrap();
-    let mut scene = Scene::build(config).unwrap();
+    let mut scene = Scene::new(config).unwrap();
     let (metrics, error) = run_scene(&mut scene, "tube", RunOptions::default());
     assert!(error.is_none(), "{error:?}");
     assert!(metrics.measures.garment().unwrap().sewn);

@@ -100,7 +100,7 @@ fn a_wall_time_bound_stops_newton_within_the_step() {
     let report = bounded.step().unwrap();
     assert!(report.newton_unconverged && report.newton_iterations == 0, "{report:?}");
     // Through the run: the bound's deadline is the scene's while it runs, and cleared after.
-    let mut run = Scene::build(scene.config.clone()).unwrap();
+    let mut run = Scene::new(scene.config.clone()).unwrap();
     let (metrics, _) = run_scene(&mut run, "bounded", RunOptions { max_wall_seconds: Some(1e-3), ..Default::default() });
     assert!(metrics.stopped_at_limit.is_some() && metrics.steps <= 2, "{:?} after {} steps", metrics.stopped_at_limit, metrics.steps);
     assert!(run.deadline.is_none());

@@ -29,7 +29,7 @@ fn run(preset: &str, overrides: &[&str]) -> (SceneConfig, Metrics) {
         metrics.vertices,
         started.elapsed().as_secs_f64()
     );
-    (config, metrics)
+    (config.into_config(), metrics)
 }
 
 /// The rig's `[[extensometer strain, stress N/m], ...]` points.

@@ -5,7 +5,7 @@
 //! plot was dominated by spikes up to 20 P_cr, and its series over time was the constant
 //! compression speed).
 
-use rosette::app::plots::{EULER_FORCE_TOP, default_series, euler_points};
+use rosette::app::plots::{EULER_FORCE_TOP, euler_points};
 use rosette::app::ui::TESTS;
 use rosette::reference::euler_elastica_from_shortening;
 use rosette::scene::measures::EulerMeasures;
@@ -88,7 +88,7 @@ fn euler_points_drop_a_synthetic_spike_and_keep_a_smooth_curve() {
 fn every_tests_default_series_changes_during_a_short_run() {
     for name in TESTS.iter().filter(|n| SCENES.iter().any(|s| s.name == **n)) {
         let (config, _) = load_scene(name, &[]).unwrap();
-        let series = default_series(config.scene.kind);
+        let series = rosette::scene::kinds::of(config.scene.kind).plot_series();
         let mut scene = Scene::build(config).unwrap();
         let mut values = Vec::new();
         // A few samples over the first 0.4 s (the drape's cloth needs that long to fall

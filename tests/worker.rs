@@ -11,11 +11,12 @@ use std::time::Duration;
 const WAIT: Duration = Duration::from_secs(120);
 
 fn preset(name: &str) -> SceneConfig {
-    load_scene(name, &[]).unwrap_or_else(|e| panic!("{name}: {e}")).0
+    load_scene(name, &[]).unwrap_or_else(|e| panic!("{name}: {e}")).0.into_config()
 }
 
 fn spawn(name: &str, config: SceneConfig) -> Worker {
-    Worker::spawn(name, config, None).unwrap_or_else(|e| panic!("{name}: {e}"))
+    let checked = rosette::scene::check::checked(config).unwrap_or_else(|e| panic!("{name}: {}", e.message));
+    Worker::spawn(name, checked, None).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 fn bits(x: &[DVec3]) -> Vec<[u64; 3]> {
@@ -24,7 +25,7 @@ fn bits(x: &[DVec3]) -> Vec<[u64; 3]> {
 
 /// The same scene stepped directly with `Scene::step`.
 fn stepped_directly(config: SceneConfig, steps: u64) -> Vec<DVec3> {
-    let mut scene = Scene::build(config).unwrap();
+    let mut scene = Scene::new(config).unwrap();
     for _ in 0..steps {
         scene.step().unwrap();
     }
@@ -48,7 +49,7 @@ fn worker_steps_match_direct_steps_bit_for_bit() {
     assert_eq!(bits(&snapshot.positions), bits(&direct), "worker and Scene::step differ");
 
     // And against the headless runner (`rosette run`) over the same simulated time.
-    let mut scene = Scene::build(config).unwrap();
+    let mut scene = Scene::new(config).unwrap();
     let duration = Some(n as f64 * scene.integrator.dt);
     let (metrics, error) = run_scene(&mut scene, "euler-buckling", RunOptions { duration, ..Default::default() });
     assert!(error.is_none());
@@ -136,7 +137,7 @@ fn a_settled_cloth_pauses_where_the_headless_run_stops() {
     assert!(!done.playing);
     let settled_at = done.settled_at.expect("the strip settles");
     assert!(done.time < config.scene.duration - 0.5, "paused at {} s of {}", done.time, config.scene.duration);
-    let mut scene = Scene::build(config).unwrap();
+    let mut scene = Scene::new(config).unwrap();
     let (metrics, error) = run_scene(&mut scene, "cantilever", RunOptions::default());
     assert!(error.is_none());
     assert_eq!((metrics.settle_time, metrics.steps), (Some(settled_at), done.steps));
@@ -173,7 +174,7 @@ fn solver_change_keeps_the_state() {
 fn solver_change_keeps_adaptive_steps() {
     let (config, _) = load_scene("cantilever", &["solver.adaptive.tolerance=1e-3".into()]).unwrap();
     assert!(config.solver.adaptive.is_some_and(|a| a.enabled));
-    let worker = spawn("cantilever", config);
+    let worker = spawn("cantilever", config.into_config());
     worker.send(Command::Step);
     let before = worker.sync(WAIT);
     worker.send(Command::SetSolver { dt: 0.002, integrator: IntegratorKind::ImplicitEuler });
@@ -305,7 +306,7 @@ fn step_time_and_real_time_factor_come_from_one_clock() {
 /// not left pinned.
 #[test]
 fn a_garment_welds_under_the_worker_and_every_snapshot_fits_its_mesh() {
-    let (mut config, _) = load_scene("skirt-gored-bias", &["mesh.edge_length=0.035".into()]).unwrap();
+    let mut config = load_scene("skirt-gored-bias", &["mesh.edge_length=0.035".into()]).unwrap().0.into_config();
     config.solver.path = rosette::settings::SolverPath::Fast;
     let worker = spawn("skirt-gored-bias", config);
     let start = worker.latest();
@@ -353,7 +354,7 @@ fn a_garment_welds_under_the_worker_and_every_snapshot_fits_its_mesh() {
 /// flat panels.
 #[test]
 fn a_sewn_garment_re_drapes_in_a_new_fabric_and_grain() {
-    let (mut config, _) = load_scene("skirt-gored-bias", &["mesh.edge_length=0.035".into()]).unwrap();
+    let mut config = load_scene("skirt-gored-bias", &["mesh.edge_length=0.035".into()]).unwrap().0.into_config();
     config.solver.path = rosette::settings::SolverPath::Fast;
     let worker = spawn("skirt-gored-bias", config.clone());
     let mut sewn = None;
@@ -391,7 +392,7 @@ fn a_sewn_garment_re_drapes_in_a_new_fabric_and_grain() {
     let error = refused.error.clone().expect("a grain of 1000° is refused");
     assert!(error.contains("grains not applied") && error.contains("grain_deg"), "{error}");
     assert_eq!(refused.topology.version, regrained.topology.version, "the running garment stays");
-    worker.send(Command::LoadScene { name: "skirt".into(), config: Box::new(config) });
+    worker.send(Command::LoadEdited { name: "skirt".into(), config: Box::new(config) });
     worker.send(Command::Step);
     let reloaded = worker.sync(WAIT);
     assert!(!reloaded.drape.from_sewn);

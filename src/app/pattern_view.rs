@@ -272,7 +272,7 @@ impl PatternView {
         }
         let mut config = (*snapshot.config).clone();
         config.garment = Some(self.edited(garment));
-        actions.push(Action::Send(Command::LoadScene { name: snapshot.scene_name.clone(), config: Box::new(config) }));
+        actions.push(Action::Send(Command::LoadEdited { name: snapshot.scene_name.clone(), config: Box::new(config) }));
         actions.push(Action::Send(Command::Play));
     }
 

@@ -1,11 +1,11 @@
 //! Live plots of the running test beside their references: the measured stress–strain
 //! curve against the fabric's input curve (paper Fig. 4), the quasi-static Euler end force
 //! against the elastica, and any scalar measure over time (by default one that the test
-//! changes, see [`default_series`]).
+//! changes, see `scene::Kind::plot_series`).
 
 use super::worker::Snapshot;
 use crate::reference::euler_elastica_from_modulus;
-use crate::scene::{Measures, SceneKind};
+use crate::scene::Measures;
 use egui::Color32;
 use egui_plot::{Corner, HLine, Legend, Line, LineStyle, Plot, PlotBounds, PlotPoints, Points};
 
@@ -62,31 +62,6 @@ impl History {
     pub fn series(&self, name: &str) -> Vec<[f64; 2]> {
         let Some(k) = self.names.iter().position(|n| n == name) else { return Vec::new() };
         self.rows.iter().filter(|(_, v)| v[k].is_finite()).map(|(t, v)| [*t, v[k]]).collect()
-    }
-}
-
-/// The measure the "over time" plot opens on for each kind of test: the rig's response,
-/// which changes while the test runs (not a setting such as the compression speed, or a
-/// constant of the fabric such as the bending length). It names one of the rig's
-/// [`Measures::scalars`].
-pub fn default_series(kind: SceneKind) -> &'static str {
-    match kind {
-        // The clamp force per width rises with the pull.
-        SceneKind::Tensile => "final_stress",
-        // The tip falls under gravity from the horizontal.
-        SceneKind::Cantilever => "tip_drop",
-        // The moment follows the curvature the grip rolls in.
-        SceneKind::Arc => "moment",
-        // The strip bows out once the end force passes the Euler load.
-        SceneKind::EulerBuckling => "midspan_deflection",
-        // The wrinkles grow as the grip shears the sheet.
-        SceneKind::ShearBuckling => "wrinkle_amplitude",
-        // The shadow shrinks as the cloth falls around the pedestal.
-        SceneKind::Drape => "drape_coefficient",
-        // The hem falls as the sewn garment drapes on the form.
-        SceneKind::Garment => "hem_height_mean",
-        // The period settles as the free edge crosses the plumb line.
-        SceneKind::Swing => "swing_period",
     }
 }
 
@@ -187,7 +162,7 @@ pub fn test_plot(ui: &mut egui::Ui, snapshot: &Snapshot) -> bool {
             });
         let mut note = format!(
             "Quasi-static: out-of-balance load on the free vertices under {:.0} % of P_cr·w (the rest drawn grey as dynamic).",
-            100.0 * crate::scene::rigs::QUASI_STATIC_IMBALANCE
+            100.0 * crate::scene::kinds::euler::QUASI_STATIC_IMBALANCE
         );
         if off_scale > 0 {
             note += &format!(" {off_scale} samples outside 0–{EULER_FORCE_TOP} P_cr are off the scale.");
@@ -216,7 +191,7 @@ pub struct EulerPoints {
 
 /// Splits the Euler rig's force samples for the plot: `quasi_static` and `dynamic` are its
 /// `quasi_static_force` and `dynamic_force` (rows of Δ/L, P N/m; the rig sorts them by their
-/// out-of-balance load, see [`crate::scene::rigs::QUASI_STATIC_IMBALANCE`]) and `euler` is
+/// out-of-balance load, see [`crate::scene::kinds::euler::QUASI_STATIC_IMBALANCE`]) and `euler` is
 /// P_cr, N/m. Samples off the scale are dropped, not allowed to stretch the axis.
 pub fn euler_points(quasi_static: &[[f64; 2]], dynamic: &[[f64; 2]], euler: f64) -> EulerPoints {
     let mut points = EulerPoints::default();

@@ -289,7 +289,7 @@ fn step_action(raw: &RawStep, scene: &SceneConfig, base: Option<&Path>) -> Resul
         return Err(format!("timeout_s = {timeout_s} must be a number of seconds above 0 and at most {LONGEST_S}"));
     }
     let garment = scene.garment.as_ref();
-    let no_garment = |what: &str| format!("{what} needs a garment scene, and this scene is a {} test", scene.scene.kind.name());
+    let no_garment = |what: &str| format!("{what} needs a garment scene, and this scene is a {} test", crate::scene::kinds::of(scene.scene.kind).name());
     let flag = |value: Option<bool>| -> Result<(), String> {
         match value {
             Some(true) => Ok(()),
@@ -452,7 +452,7 @@ mod tests {
     use super::*;
 
     fn scene(name: &str) -> SceneConfig {
-        crate::scene::load_scene(name, &[]).unwrap().0
+        crate::scene::load_scene(name, &[]).unwrap().0.into_config()
     }
 
     fn write(name: &str, text: &str) -> PathBuf {

@@ -500,7 +500,7 @@ impl ViewerUi {
             // while the scene keeps that measure.
             let kind = snapshot.config.scene.kind;
             if self.history_kind != Some(kind) || !self.history.names.contains(&self.history_choice) {
-                let default = plots::default_series(kind);
+                let default = crate::scene::kinds::of(kind).plot_series();
                 self.history_choice =
                     if self.history.names.iter().any(|n| n == default) { default.to_string() } else { self.history.names[0].clone() };
                 self.history_kind = Some(kind);

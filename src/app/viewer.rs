@@ -12,7 +12,7 @@ use super::script::Script;
 use super::session::{Control, FrameInput, Session};
 use super::ui::{Action, FileDialog, ViewerUi};
 use super::worker::{Command, Snapshot, Worker};
-use crate::scene::{SceneConfig, load_scene};
+use crate::scene::{CheckedScene, load_scene};
 use crate::settings::SCENES;
 use anyhow::{Context, anyhow};
 use egui_wgpu::wgpu;
@@ -34,7 +34,7 @@ pub struct ViewerOptions {
     /// `KEY=VALUE` overrides of the first scene, as `rosette run --set` takes them.
     pub overrides: Vec<String>,
     /// The first scene, already loaded and checked (else `preset` and `overrides` are).
-    pub config: Option<SceneConfig>,
+    pub config: Option<CheckedScene>,
     /// A scripted session, read and checked, played from the first frame.
     pub script: Option<Script>,
     /// Where the session's report is written (JSON), once it ends.
@@ -42,10 +42,15 @@ pub struct ViewerOptions {
 }
 
 /// Loads the scene the viewer opens on, on the path it opens on (`plan::opening_path`).
-pub fn load_first_scene(spec: &str, overrides: &[String]) -> Result<SceneConfig, String> {
-    let (mut config, _) = load_scene(spec, overrides).map_err(|e| e.to_string())?;
-    config.solver.path = crate::scene::plan::opening_path(&config);
-    Ok(config)
+pub fn load_first_scene(spec: &str, overrides: &[String]) -> Result<CheckedScene, String> {
+    let (checked, _) = load_scene(spec, overrides).map_err(|e| e.to_string())?;
+    let path = crate::scene::plan::opening_path(&checked);
+    if path == checked.solver.path {
+        return Ok(checked);
+    }
+    let mut config = checked.into_config();
+    config.solver.path = path;
+    crate::scene::check::checked(config).map_err(|e| e.message)
 }
 
 /// The scene the viewer opens on: the Cusick drape where it exists, else Euler buckling.

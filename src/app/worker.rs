@@ -33,7 +33,9 @@ pub type PropSurface = (Vec<DVec3>, Vec<[u32; 3]>);
 pub enum Command {
     /// Builds and shows a new scene (paused at t = 0), labelled `name` (a preset name or a
     /// file). A scene that fails to build is reported and the current one kept.
-    LoadScene { name: String, config: Box<SceneConfig> },
+    LoadScene { name: String, config: Box<crate::scene::CheckedScene> },
+    /// Settings edited in the window (a pattern's seams): checked, then loaded.
+    LoadEdited { name: String, config: Box<SceneConfig> },
     /// Runs the scene, paced to wall time.
     Play,
     /// Stops stepping; the state stays.
@@ -270,8 +272,7 @@ pub struct Worker {
 /// a scene file meets, so that an edit the command line would refuse is refused here too,
 /// with the same message, and the running scene stays.
 fn checked_build(config: SceneConfig) -> Result<Scene, String> {
-    crate::settings::validate::check_scene(&config).map_err(|e| e.message)?;
-    Scene::build(config).map_err(|e| e.to_string())
+    Scene::new(config).map_err(|e| e.to_string())
 }
 
 impl Worker {
@@ -279,7 +280,7 @@ impl Worker {
     /// `on_publish` is called (on the worker thread) after each publish, e.g. to wake the UI.
     pub fn spawn(
         name: &str,
-        config: SceneConfig,
+        config: crate::scene::CheckedScene,
         on_publish: Option<Box<dyn Fn() + Send>>,
     ) -> Result<Self, crate::scene::SceneError> {
         let scene = Scene::build(config)?;
@@ -523,9 +524,8 @@ impl WorkerState {
         self.dirty = true;
         self.diverged = false;
         match command {
-            Command::LoadScene { name, config } => {
-                self.load(*config, Some(name), false).unwrap_or_else(|e| self.error = Some(e));
-            }
+            Command::LoadScene { name, config } => self.load(Scene::build(*config).map_err(|e| e.to_string()), Some(name), false),
+            Command::LoadEdited { name, config } => self.load(checked_build(*config), Some(name), false),
             Command::Play => {
                 self.playing = true;
                 self.user_paused = false;
@@ -543,7 +543,7 @@ impl WorkerState {
             Command::Reset => {
                 let config = self.scene.config.clone();
                 let playing = self.playing;
-                self.load(config, None, playing).unwrap_or_else(|e| self.error = Some(e));
+                self.load(checked_build(config), None, playing);
                 self.drape.0.cause = DrapeCause::Reset;
             }
             Command::SetFabric(fabric) => {
@@ -569,19 +569,26 @@ impl WorkerState {
             Command::DragVertex { vertex, mesh, target } => self.drag(vertex, mesh, target),
             Command::ReleaseDrag => self.release_drag(),
             Command::RunTest(name) => match load_scene(&name, &[]) {
-                Ok((mut config, _)) => {
+                Ok((checked, _)) => {
+                    let mut config = checked.into_config();
                     config.fabric = self.scene.config.fabric.clone();
-                    self.load(config, Some(name), true).unwrap_or_else(|e| self.error = Some(e));
+                    self.load(checked_build(config), Some(name), true);
                 }
                 Err(e) => self.error = Some(e.to_string()),
             },
         }
     }
 
-    /// Builds `config` and makes it the running scene, labelled `name` (the old label when
-    /// `None`). On failure the current scene stays and the message is returned.
-    fn load(&mut self, config: SceneConfig, name: Option<String>, play: bool) -> Result<(), String> {
-        let scene = checked_build(config)?;
+    /// Makes `built` the running scene, labelled `name` (the old label when `None`). A
+    /// scene that failed to build leaves the current one running and its message shown.
+    fn load(&mut self, built: Result<Scene, String>, name: Option<String>, play: bool) {
+        let scene = match built {
+            Ok(scene) => scene,
+            Err(e) => {
+                self.error = Some(e);
+                return;
+            }
+        };
         self.scene = scene;
         if let Some(name) = name {
             self.scene_name = name;
@@ -589,7 +596,6 @@ impl WorkerState {
         self.install_scene_data();
         self.playing = play;
         self.pace = (Instant::now(), 0.0);
-        Ok(())
     }
 
     /// Rebuilds the scene for an edit (a fabric, grains, the path) and drapes it again: a

@@ -6,7 +6,7 @@ use super::picture::{self, THREE_QUARTER, blit, placeholder};
 use super::suite::parallel_map;
 use super::{CardError, DrapeResult, Progress};
 use crate::render::Headless;
-use crate::scene::{RunOptions, Scene, SceneConfig, SceneKind, load_scene, run_scene};
+use crate::scene::{CheckedScene, RunOptions, Scene, load_scene, run_scene};
 use glam::DVec3;
 use image::RgbaImage;
 use plotters::prelude::*;
@@ -82,7 +82,7 @@ impl Comparison {
 /// Each fabric's scene: `scene` with `overrides` and `fabric.preset` set to the fabric, as
 /// `rosette run SCENE --set fabric.preset=FABRIC` builds it. Refuses anything but a drape
 /// scene, and names the fabric whose file is missing or wrong.
-pub fn configs(fabrics: &[String], scene: &str, overrides: &[String]) -> Result<Vec<SceneConfig>, CardError> {
+pub fn configs(fabrics: &[String], scene: &str, overrides: &[String]) -> Result<Vec<CheckedScene>, CardError> {
     if fabrics.is_empty() {
         return Err(CardError::BadInput("name at least one fabric to compare".into()));
     }
@@ -92,7 +92,7 @@ pub fn configs(fabrics: &[String], scene: &str, overrides: &[String]) -> Result<
             let mut all = overrides.to_vec();
             all.push(format!("fabric.preset={}", toml::Value::String(fabric.clone())));
             let (config, _) = load_scene(scene, &all).map_err(|e| CardError::BadInput(format!("fabric '{fabric}': {e}")))?;
-            if !matches!(config.scene.kind, SceneKind::Drape | SceneKind::Garment) {
+            if !crate::scene::kinds::of(config.scene.kind).drapes() {
                 return Err(CardError::BadInput(format!(
                     "--scene {scene}: not a drape or garment scene, so it has no drape coefficient to compare; use cusick-drape-30, cusick-drape, tablecloth or a garment such as skirt-gored-bias"
                 )));
@@ -103,9 +103,9 @@ pub fn configs(fabrics: &[String], scene: &str, overrides: &[String]) -> Result<
 }
 
 /// Runs every config (in parallel, one per core) to its end or until it settles.
-pub fn run(fabrics: &[String], configs: Vec<SceneConfig>, progress: &Progress) -> Vec<(Entry, Option<Scene>)> {
+pub fn run(fabrics: &[String], configs: Vec<CheckedScene>, progress: &Progress) -> Vec<(Entry, Option<Scene>)> {
     progress.total.store(configs.len(), std::sync::atomic::Ordering::Relaxed);
-    let jobs: Vec<(String, SceneConfig)> = fabrics.iter().cloned().zip(configs).collect();
+    let jobs: Vec<(String, CheckedScene)> = fabrics.iter().cloned().zip(configs).collect();
     parallel_map(&jobs, |(fabric, config)| {
         let started = Instant::now();
         progress.start(fabric);

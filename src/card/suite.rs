@@ -8,7 +8,7 @@ use crate::fabric::units::GF_CM_PER_CM;
 use crate::lab::{self, CantileverTest, Direction, KesTensile, LabRuns, PureBending, ShearTest, TensilePull};
 use crate::physics::{bending_length, weight_per_area};
 use crate::settings::{FabricConfig, SCENES};
-use crate::scene::{Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
+use crate::scene::{CheckedScene, Metrics, RunOptions, Scene, SceneConfig, load_scene, run_scene};
 use crate::sim::BendingStiffness;
 use std::time::Instant;
 
@@ -81,14 +81,13 @@ pub fn scene_fabric(config: &SceneConfig, fabric: &FabricConfig) -> Result<Fabri
 }
 
 /// The bundled drape scene `scene` with `fabric` in it ([`scene_fabric`]).
-pub fn drape_config(scene: &str, fabric: &FabricConfig) -> Result<SceneConfig, CardError> {
+pub fn drape_config(scene: &str, fabric: &FabricConfig) -> Result<CheckedScene, CardError> {
     if !SCENES.iter().any(|s| s.name == scene) {
         return Err(CardError::BadInput(format!("no bundled scene named '{scene}'")));
     }
-    let (mut config, _) = load_scene(scene, &[]).map_err(|e| CardError::BadInput(e.to_string()))?;
+    let mut config = load_scene(scene, &[]).map_err(|e| CardError::BadInput(e.to_string()))?.0.into_config();
     config.fabric = scene_fabric(&config, fabric)?;
-    config.material().map_err(|e| CardError::BadInput(format!("{scene} with this fabric: {e}")))?;
-    Ok(config)
+    crate::scene::check::checked(config).map_err(|e| CardError::BadInput(format!("{scene} with this fabric: {}", e.message)))
 }
 
 /// The strain the bias strip is pulled to: as far as the warp and weft input curves go, so
@@ -116,7 +115,7 @@ fn input_to_fm(curve: &[[f64; 2]]) -> Vec<[f64; 2]> {
     out
 }
 
-fn run_job(job: Job, fabric: &FabricConfig, drape: &SceneConfig, progress: &Progress) -> Result<Outcome, CardError> {
+fn run_job(job: Job, fabric: &FabricConfig, drape: &CheckedScene, progress: &Progress) -> Result<Outcome, CardError> {
     let width = crate::fabric::bias::STANDARD_STRIP_WIDTH;
     Ok(match job {
         Job::Drape => {
@@ -190,7 +189,7 @@ struct Results {
 
 /// Runs every test of the suite as one job on rayon's pool, the drape first (it is the
 /// longest); the first error, or the cancellation, ends the card.
-fn run_suite(fabric: &FabricConfig, drape: &SceneConfig, progress: &Progress) -> Result<Results, CardError> {
+fn run_suite(fabric: &FabricConfig, drape: &CheckedScene, progress: &Progress) -> Result<Results, CardError> {
     let mut jobs = vec![Job::Drape];
     jobs.extend(Direction::ALL.map(Job::Cantilever));
     jobs.push(Job::Shear);

@@ -183,7 +183,7 @@ impl Case {
         // needs (tens of millions on the stiffest maps): the sweep's cases are bounded by
         // construction, not by the command line's default step bound.
         overrides.push(format!("scene.max_steps={}", i64::MAX));
-        let (mut config, _) = load_scene(self.problem.preset(), &overrides).map_err(|e| e.to_string())?;
+        let mut config = load_scene(self.problem.preset(), &overrides).map_err(|e| e.to_string())?.0.into_config();
         let f = &mut config.fabric.properties;
         for point in f.tensile_warp.iter_mut().chain(f.tensile_weft.iter_mut()) {
             point[1] *= self.tensile_scale;
@@ -208,7 +208,7 @@ impl Case {
 
     fn run_into(&self, outcome: &mut Outcome) -> Result<(), String> {
         // The model does not depend on dt: build it once at a nominal step for the limit.
-        let probe = Scene::build(self.config(Some(1e-3))?).map_err(|e| e.to_string())?;
+        let probe = Scene::new(self.config(Some(1e-3))?).map_err(|e| e.to_string())?;
         outcome.explicit_limit = explicit_limit(&probe);
         outcome.triangles = probe.model.triangle_count();
         let f = &probe.config.fabric.properties;
@@ -221,7 +221,7 @@ impl Case {
             Step::Scene => None,
         };
         let config = self.config(dt)?;
-        let mut scene = Scene::build(config.clone()).map_err(|e| e.to_string())?;
+        let mut scene = Scene::new(config.clone()).map_err(|e| e.to_string())?;
         let cpu = cpu_time::ThreadTime::now();
         let (metrics, error) = run_scene(&mut scene, self.problem.name(), RunOptions::default());
         outcome.cpu_seconds = cpu.elapsed().as_secs_f64();
@@ -245,8 +245,8 @@ impl Case {
 pub fn explicit_limit(scene: &Scene) -> f64 {
     let x = &scene.state.x;
     let at_rest = scene.model.explicit_step_limit(x);
-    match scene.config.test.max_strain {
-        Some(strain) if scene.config.scene.kind == crate::scene::SceneKind::Tensile => {
+    match crate::scene::kinds::of(scene.config.scene.kind).final_stretch(&scene.config) {
+        Some(strain) => {
             let stretched: Vec<DVec3> = x.iter().map(|p| DVec3::new(p.x * (1.0 + strain), p.y, p.z)).collect();
             at_rest.min(scene.model.explicit_step_limit(&stretched))
         }

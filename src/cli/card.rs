@@ -92,7 +92,7 @@ pub fn compare(fabrics: &[String], scene: &str, overrides: &[String], out: &Path
     for (path, kind) in paths.iter().zip([PICTURE, COMPARE_JSON, COMPARE_CSV]) {
         plan.add("--out", path, kind);
     }
-    if let Err(e) = outputs::check(&plan, &configs.iter().collect::<Vec<_>>()) {
+    if let Err(e) = outputs::check(&plan, &configs.iter().map(|c| &**c).collect::<Vec<_>>()) {
         return bad_input(e);
     }
     // The props start clear of the cloth: every fabric is draped on the same geometry.

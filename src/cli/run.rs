@@ -7,7 +7,6 @@ use super::args::{DEFAULT_MAX_WALL, ScreenshotArgs};
 use rosette::io::guard::Plan;
 use rosette::io::number::short;
 use rosette::io::write::Output;
-use rosette::scene::plan::RunPlan;
 use rosette::scene::{RunFlags, load_scene_with};
 use rosette::scene::{RunOptions, Scene, SceneConfig, StepRecord, possible, run_scene};
 use rosette::{errln, outln, render};
@@ -53,7 +52,7 @@ impl Default for RunLimits {
 /// The outputs `run` will write, checked against its inputs, each other and the files
 /// already there; also the formats their names promise.
 fn plan_outputs(config: &SceneConfig, spec: &str, outputs: &RunOutputs, shot: &ScreenshotArgs) -> Result<(), String> {
-    if outputs.outline.is_some() && config.scene.kind != rosette::scene::SceneKind::Drape {
+    if outputs.outline.is_some() && !rosette::scene::kinds::of(config.scene.kind).writes_outline() {
         return Err(format!("--outline: {spec} is not a drape scene; only drape scenes have a shadow outline"));
     }
     if let Some(path) = shot.screenshot.as_deref().filter(|p| !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))) {
@@ -90,12 +89,9 @@ fn plan_outputs(config: &SceneConfig, spec: &str, outputs: &RunOutputs, shot: &S
 /// `rosette run SCENE --plan`: the scene's run plan in words, nothing run or written.
 pub fn print_plan(spec: &str, overrides: &[String], duration: Option<f64>) -> ExitCode {
     let flags = RunFlags { duration, max_steps: None };
-    let plan = load_scene_with(spec, overrides, &flags)
-        .map_err(|e| e.to_string())
-        .and_then(|(config, _)| Ok((RunPlan::resolve(&config).map_err(|e| format!("{spec}: {e}"))?, config)));
-    match plan {
-        Ok((plan, config)) => {
-            outln!("{spec}: {}", plan.describe(&config).trim_end());
+    match load_scene_with(spec, overrides, &flags) {
+        Ok((checked, _)) => {
+            outln!("{spec}: {}", checked.plan().describe(&checked).trim_end());
             ExitCode::SUCCESS
         }
         Err(e) => bad_input(e),
@@ -309,7 +305,7 @@ fn outcome(name: &str, scene: &Scene, metrics: &rosette::scene::Metrics, error: 
             metrics.newton_limit_steps,
             metrics.worst_residual,
             scene.integrator.newton.tolerance,
-            unconverged_advice(&scene.config)
+            unconverged_advice(&scene)
         );
         return ExitCode::from(EXIT_NOT_CONVERGED);
     }
@@ -342,10 +338,11 @@ fn outcome(name: &str, scene: &Scene, metrics: &rosette::scene::Metrics, error: 
     if output_failed { lost } else { ExitCode::SUCCESS }
 }
 
-/// What to change when Newton stops short: the limits the scene lowered below their
-/// defaults first, then more iterations, then a shorter step (never what the run already
-/// has).
-fn unconverged_advice(config: &SceneConfig) -> String {
+/// What to change when Newton stops short: the limits the scene or its run plan lowered
+/// below their defaults first, then more iterations, then a shorter step (never what the
+/// run already has).
+fn unconverged_advice(scene: &Scene) -> String {
+    let config = &scene.config;
     let n = &config.solver.newton;
     let defaults = rosette::sim::NewtonSettings::default();
     let mut advice = Vec::new();
@@ -355,9 +352,9 @@ fn unconverged_advice(config: &SceneConfig) -> String {
             n.cg_max_iterations, defaults.cg_max_iterations
         ));
     }
-    let fast = &config.solver.fast;
-    if config.solver.path == rosette::settings::SolverPath::Fast && config.scene.kind == rosette::settings::SceneKind::Garment && fast.cg_max_iterations < n.cg_max_iterations {
-        advice.push(format!("raise solver.fast.cg_max_iterations (now {}): a garment's linear solves stop there on the fast path", fast.cg_max_iterations));
+    // The run plan's own, lower limit (a garment's on the fast path), as the plan recorded it.
+    if let Some(choice) = scene.plan_choices().iter().find(|c| c.key == "solver.newton.cg_max_iterations" && !c.kept) {
+        advice.push(format!("raise solver.fast.cg_max_iterations (now {}): the run plan stops this scene's linear solves there on the fast path", choice.value));
     }
     if n.cg_tolerance > defaults.cg_tolerance {
         advice.push(format!("lower solver.newton.cg_tolerance (now {}, default {})", short(n.cg_tolerance), short(defaults.cg_tolerance)));

@@ -88,7 +88,7 @@ pub struct GarmentConfig {
 pub(crate) fn default_seam_ease() -> f64 {
     0.05
 }
-fn default_sewing_stiffness() -> f64 {
+pub(crate) fn default_sewing_stiffness() -> f64 {
     50.0
 }
 fn default_sewing_ramp() -> f64 {
@@ -100,7 +100,7 @@ fn default_sewing_damping() -> f64 {
 fn default_sewing_time() -> f64 {
     1.5
 }
-fn default_closed_share() -> f64 {
+pub(crate) fn default_closed_share() -> f64 {
     0.25
 }
 

@@ -80,7 +80,7 @@ pub enum LabError {
 
 /// A bundled scene with `fabric` in it; `edit` sets the test's geometry.
 fn scene_config(test: &'static str, preset: &str, fabric: &FabricConfig, edit: impl FnOnce(&mut SceneConfig)) -> Result<SceneConfig, LabError> {
-    let (mut config, _) = load_scene(preset, &[]).map_err(|e| LabError::Setup { test, message: e.to_string() })?;
+    let mut config = load_scene(preset, &[]).map_err(|e| LabError::Setup { test, message: e.to_string() })?.0.into_config();
     // Drape-only settings of the fabric (the scene's own overrides) are not carried over:
     // the test sees the fabric as given.
     config.fabric = fabric.clone();
@@ -90,7 +90,7 @@ fn scene_config(test: &'static str, preset: &str, fabric: &FabricConfig, edit: i
 
 /// Builds and runs a scene to its end (or until it settles).
 fn run(test: &'static str, config: SceneConfig) -> Result<Metrics, LabError> {
-    let mut scene = Scene::build(config).map_err(|e| LabError::Setup { test, message: e.to_string() })?;
+    let mut scene = Scene::new(config).map_err(|e| LabError::Setup { test, message: e.to_string() })?;
     let (metrics, error) = run_scene(&mut scene, test, RunOptions::default());
     match error {
         Some(e) => Err(LabError::Diverged { test, message: e.to_string() }),

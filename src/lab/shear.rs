@@ -55,7 +55,7 @@ pub fn shear(fabric: &FabricConfig) -> Result<ShearTest, LabError> {
         c.scene.settle_speed = None;
     })?;
     let (length, width) = (config.cloth.length, config.cloth.width);
-    let mut scene = Scene::build(config).map_err(|e| LabError::Setup { test: TEST, message: e.to_string() })?;
+    let mut scene = Scene::new(config).map_err(|e| LabError::Setup { test: TEST, message: e.to_string() })?;
     let rest = scene.model.rest.clone();
     let grip: Vec<usize> = (0..rest.len()).filter(|&v| rest[v].y > width - 1e-9).collect();
     let middle: Vec<usize> = grip.iter().copied().filter(|&v| (rest[v].x - 0.5 * length).abs() <= 0.25 * length + 1e-9).collect();

@@ -65,7 +65,7 @@ pub fn kes_tensile(fabric: &FabricConfig, direction: Direction) -> Result<KesTen
         c.scene.settle_speed = None;
     })?;
     let (length, width, h) = (config.cloth.length, config.cloth.width, config.mesh.edge_length);
-    let mut scene = Scene::build(config).map_err(|e| LabError::Setup { test: TEST, message: e.to_string() })?;
+    let mut scene = Scene::new(config).map_err(|e| LabError::Setup { test: TEST, message: e.to_string() })?;
     let rest = scene.model.rest.clone();
     let moving: Vec<usize> = (0..rest.len()).filter(|&v| rest[v].x > length - 1e-9).collect();
     let columns = Columns::new(&rest, length, h);
@@ -128,7 +128,7 @@ pub fn strain_pull(fabric: &FabricConfig, direction: Direction, max_strain: f64,
         c.scene.duration = max_strain * strip.length / c.test.speed.unwrap_or(0.001);
         c.scene.settle_speed = None;
     })?;
-    let mut scene = Scene::build(config).map_err(|e| LabError::Setup { test: TEST, message: e.to_string() })?;
+    let mut scene = Scene::new(config).map_err(|e| LabError::Setup { test: TEST, message: e.to_string() })?;
     let rest = scene.model.rest.clone();
     let moving: Vec<usize> = (0..rest.len()).filter(|&v| rest[v].x > strip.length - 1e-9).collect();
     let columns = Columns::new(&rest, strip.length, strip.edge);

@@ -83,6 +83,7 @@ impl Scene {
         self.integrator = next.integrator;
         self.sample_every = next.sample_every;
         self.level_edge = next.level_edge;
+        self.level_solver = next.level_solver;
         let earlier = std::mem::replace(&mut self.rig, next.rig);
         self.rig.continue_history(earlier);
     }

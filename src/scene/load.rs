@@ -3,6 +3,7 @@
 //! or the flag that gave the value (`Sources`), in the terms the user wrote it in: a sheet's
 //! field rather than the fabric key it became, `--duration` rather than `scene.duration`.
 
+use super::check::CheckedScene;
 use crate::settings::read::{PresetKind, apply_override, looks_like_path, parse_override, read_preset};
 use crate::settings::{FabricConfig, Origin, Origins, PresetError, SceneConfig};
 use crate::fabric::Import;
@@ -149,12 +150,12 @@ fn deserialize_named<T: serde::de::DeserializeOwned>(table: toml::Table) -> Resu
 /// Loads a scene by bundled name or path, applies `overrides` (`KEY=VALUE`), merges its
 /// fabric and checks everything: a value out of range is refused here, with the file or
 /// the `--set` that gave it, its key and how to fix it.
-pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(SceneConfig, String), PresetError> {
+pub fn load_scene(spec: &str, overrides: &[String]) -> Result<(CheckedScene, String), PresetError> {
     load_scene_with(spec, overrides, &RunFlags::default())
 }
 
 /// [`load_scene`] for a run with `flags` (`rosette run --duration`, `--max-steps`).
-pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Result<(SceneConfig, String), PresetError> {
+pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Result<(CheckedScene, String), PresetError> {
     let (own, file) = read_preset(PresetKind::Scene, spec, None, Some("scene"))?;
     let (mut table, base_table) = crate::settings::read::with_base(own.clone(), &file)?;
     let base = if looks_like_path(spec) || Path::new(spec).exists() { Path::new(spec).parent().map(Path::to_path_buf) } else { None };
@@ -247,7 +248,7 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
     config.base_dir = base;
     config.origins = origins;
     config.own_fabric_keys = own_fabric_keys;
-    crate::settings::validate::check_scene_for(&config, flags.duration).map_err(|e| match (e.key.as_str(), flags.duration) {
+    let checked = super::check::checked_for(config, flags.duration).map_err(|e| match (e.key.as_str(), flags.duration) {
         ("--duration", Some(d)) => PresetError::Invalid { file: format!("--duration {}", short(d)), message: sources.in_flags(e.message) },
         (key, _) if key.starts_with("fabric.") => sources.fabric_invalid(key, e.message),
         (key, _) => {
@@ -256,7 +257,7 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
             sources.invalid(&set.unwrap_or_else(|| key_parts(key)), e.message)
         }
     })?;
-    Ok((config, file))
+    Ok((checked, file))
 }
 
 /// Turns a fabric table's measurement sheets (`[kes]`, `[fast]`, `[cantilever]`) into

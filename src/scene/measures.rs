@@ -1,6 +1,6 @@
 //! What each test rig measures, as one typed struct per rig.
 //!
-//! The rigs (`rigs.rs`) fill these in; the metrics JSON (`rosette run --metrics`), the
+//! The scene kinds' rigs (`kinds/`) fill these in; the metrics JSON (`rosette run --metrics`), the
 //! viewer's plots and CSV export, the chart, the bench and the tests read their fields, so
 //! that a misspelt measure is a compile error rather than an empty plot. The JSON is the
 //! serde form of these structs: each rig's measures are one object whose keys are the field
@@ -26,8 +26,8 @@ pub enum Measures {
     Euler(EulerMeasures),
     Shear(ShearMeasures),
     /// Before `Drape`: a garment's JSON holds fields no drape has, a drape's lacks them.
-    Garment(super::garment::rig::GarmentMeasures),
-    Swing(super::swing::SwingMeasures),
+    Garment(GarmentMeasures),
+    Swing(SwingMeasures),
     Drape(DrapeMeasures),
 }
 
@@ -120,7 +120,7 @@ pub struct EulerMeasures {
     /// [`EulerMeasures::OUT_OF_BALANCE_DEFINITION`].
     pub out_of_balance_definition: String,
     /// (end shortening Δ/L, end force N/m) of the quasi-static samples (out of balance
-    /// under `rigs::QUASI_STATIC_IMBALANCE`), at most about a hundred.
+    /// under `kinds::euler::QUASI_STATIC_IMBALANCE`), at most about a hundred.
     pub quasi_static_force: Vec<[f64; 2]>,
 }
 
@@ -251,11 +251,11 @@ impl Measures {
         if let Measures::Drape(m) = self { Some(m) } else { None }
     }
 
-    pub fn garment(&self) -> Option<&super::garment::rig::GarmentMeasures> {
+    pub fn garment(&self) -> Option<&GarmentMeasures> {
         if let Measures::Garment(m) = self { Some(m) } else { None }
     }
 
-    pub fn swing(&self) -> Option<&super::swing::SwingMeasures> {
+    pub fn swing(&self) -> Option<&SwingMeasures> {
         if let Measures::Swing(m) = self { Some(m) } else { None }
     }
 
@@ -366,6 +366,86 @@ impl Measures {
             Measures::Swing(m) => vec![series("bottom_history", &["time_s", "displacement_m"], &m.bottom_history)],
             Measures::Cantilever(_) | Measures::Arc(_) | Measures::Shear(_) | Measures::Garment(_) => Vec::new(),
         }
+    }
+}
+
+/// What the swing measures.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SwingMeasures {
+    /// (time s, mean sideways displacement of the free edge m).
+    pub bottom_history: Vec<[f64; 2]>,
+    /// The hanging chain's first-mode period for the strip's length, s.
+    pub chain_period: f64,
+    /// Half periods between the free edge's zero crossings that were measured.
+    pub half_periods: usize,
+    /// The period measured, twice the mean time between zero crossings, s; None with fewer
+    /// than two half periods (a run too short to tell).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub swing_period: Option<f64>,
+}
+
+/// A garment's measurements, SI units (m, m², s).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct GarmentMeasures {
+    /// (A_shadow − A_waist) / (A_pattern + A_waist − A_waist): the Cusick drape coefficient
+    /// with the form's section at the waist as the support and the flat pattern around it
+    /// as the specimen (a full-circle skirt's is exactly Cusick's).
+    pub garment_drape_coefficient: f64,
+    /// Height of the hem above the floor: mean, lowest, highest, and its standard
+    /// deviation (the hem's evenness), m.
+    pub hem_height_max: f64,
+    pub hem_height_mean: f64,
+    pub hem_height_min: f64,
+    pub hem_height_spread: f64,
+    /// Folds (nodes) of the shadow's outline around the form's axis.
+    pub hem_nodes: usize,
+    /// Largest and smallest radius of the shadow's outline from the form's axis, m.
+    pub hem_radius_max: f64,
+    pub hem_radius_min: f64,
+    /// Largest distance between a seam's vertex pairs now, m (zero once welded).
+    pub open_seam_gap: f64,
+    /// Pattern pieces, and vertex pairs along the seams.
+    pub panels: usize,
+    /// Area of the flat pattern, m².
+    pub pattern_area: f64,
+    /// Largest distance between seam pairs when they were welded, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seam_gap_at_weld: Option<f64>,
+    pub seam_pairs: usize,
+    /// Per seam: its length along side a now, and the rest lengths of sides a and b, m.
+    pub seams: Vec<[f64; 3]>,
+    /// Whether every seam was closed and welded.
+    pub sewn: bool,
+    /// When the seams were welded, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sewn_at: Option<f64>,
+    /// Area of the garment's vertical projection together with the form's waist section, m².
+    pub shadow_area: f64,
+    /// Area of the form's section the drape coefficient is taken against, m².
+    pub waist_area: f64,
+    /// Why the garment is not hanging on its form (slid off, fallen, inside it), where it
+    /// is not: its drape measures are then withheld (null).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub off_form: Option<String>,
+}
+
+impl GarmentMeasures {
+    /// Withholds the measures of a garment hanging on its form, saying why (`reason`).
+    pub fn withhold(&mut self, reason: String) {
+        for value in [
+            &mut self.garment_drape_coefficient,
+            &mut self.hem_height_max,
+            &mut self.hem_height_mean,
+            &mut self.hem_height_min,
+            &mut self.hem_height_spread,
+            &mut self.hem_radius_max,
+            &mut self.hem_radius_min,
+            &mut self.shadow_area,
+        ] {
+            *value = f64::NAN;
+        }
+        self.hem_nodes = 0;
+        self.off_form = Some(reason);
     }
 }
 

@@ -6,20 +6,22 @@ pub mod garment;
 pub mod levels;
 pub mod load;
 pub mod measures;
+pub mod check;
 /// The memory estimate lives with the checks that use it before any mesh is built.
-pub use crate::settings::validate::memory;
+pub use check::memory;
 pub mod possible;
 pub mod props;
-pub mod rigs;
+pub mod kinds;
 pub mod run;
 pub mod strip;
 pub mod plan;
-pub mod swing;
 pub mod topology;
 
 pub use measures::Measures;
 pub use topology::Topology;
 pub use crate::settings::{SceneConfig, SceneKind};
+pub use kinds::Kind;
+pub use check::CheckedScene;
 pub use load::{RunFlags, load_scene, load_scene_with};
 pub use run::{ContactEvents, Metrics, RunOptions, SettleWatch, StepRecord, run_scene};
 
@@ -28,7 +30,7 @@ use crate::sim::{Integrator, Mesh, Model, ModelError, PhysicsOptions, State, Ste
 use crate::physics::STANDARD_GRAVITY;
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
-use rigs::Rig;
+use kinds::{Rig, Specimen};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -37,6 +39,21 @@ pub enum SceneError {
     Model(#[from] ModelError),
     #[error("{0}")]
     Setup(String),
+    /// Settings the checks refused (`Scene::new`): the message names the key.
+    #[error("{}", .0.message)]
+    Invalid(check::Invalid),
+}
+
+impl From<check::Invalid> for SceneError {
+    fn from(e: check::Invalid) -> Self {
+        Self::Invalid(e)
+    }
+}
+
+/// What the checks built, shared by every level of a scene.
+struct Built<'a> {
+    fabric: &'a crate::sim::Fabric,
+    props: &'a [crate::sim::contact::Prop],
 }
 
 /// A scene ready to step: model, state, integrator and its rig's measurements.
@@ -45,7 +62,7 @@ pub struct Scene {
     pub model: Model,
     pub state: State,
     pub integrator: Integrator,
-    pub rig: Rig,
+    pub rig: Box<dyn Rig>,
     /// Rigid props the cloth collides with.
     pub props: Vec<crate::sim::contact::Prop>,
     /// Steps between measurement samples.
@@ -55,6 +72,9 @@ pub struct Scene {
     /// The edge length of the fast path's level the scene is on (None: the scene's own
     /// mesh and settings).
     level_edge: Option<f64>,
+    /// The solver settings the plan gave the level the scene is on: what a rebuilt
+    /// integrator (a welded garment) is made from.
+    level_solver: crate::settings::SolverSection,
     /// A garment's sewing (None for other scenes).
     pub garment: Option<garment::Sewing>,
     /// Wall-clock time past which no step starts another Newton iteration
@@ -74,58 +94,68 @@ pub struct Scene {
 const POOL_STEP_TRIANGLES: usize = 4096;
 
 impl Scene {
-    pub fn build(config: SceneConfig) -> Result<Self, SceneError> {
-        let plan = plan::RunPlan::resolve(&config)?;
+    /// Builds a scene the checks passed, with what they built (its fabric, props, a
+    /// garment's pattern) and on the plan they resolved.
+    pub fn build(checked: CheckedScene) -> Result<Self, SceneError> {
+        let check::Checked { config, fabric, props, mut garment, plan } = checked.into_parts();
         let choices = plan.levels.last().map(|l| l.choices.clone()).unwrap_or_default();
         let mut levels = plan.levels.into_iter();
         let first = levels.next().expect("a plan has at least one level");
-        let mut scene = Self::build_level(config.clone(), first)?;
+        let built = Built { fabric: &fabric, props: &props };
+        let mut scene = Self::build_level(config.clone(), first, &built, garment.take())?;
         if plan.design == plan::Design::Settling {
             // Every finer level is built now, so that a bad mesh is refused before any work.
-            let pending = levels.map(|level| Self::build_level(config.clone(), level)).collect::<Result<_, _>>()?;
+            let pending = levels.map(|level| Self::build_level(config.clone(), level, &built, None)).collect::<Result<_, _>>()?;
             scene.levels = Some(levels::Levels::new(&scene, pending));
         }
         scene.plan_choices = choices;
         Ok(scene)
     }
 
+    /// Checks `config` and builds it: what a changed setting goes through.
+    pub fn new(config: SceneConfig) -> Result<Self, SceneError> {
+        Self::build(check::checked(config)?)
+    }
+
     /// One level of the scene's plan: `config` is the scene's own settings, kept for a
-    /// later re-plan; the level's are what it is built and stepped with.
-    pub(crate) fn build_level(config: SceneConfig, level: plan::Level) -> Result<Self, SceneError> {
+    /// later re-plan; the level's are what it is built and stepped with. `garment` is the
+    /// pattern the checks meshed at the scene's own edge length.
+    fn build_level(config: SceneConfig, level: plan::Level, built: &Built, garment: Option<crate::garment::Garment>) -> Result<Self, SceneError> {
         let edge_length = level.fast.then_some(level.edge_length);
         let level_config = level.config;
-        let fabric = level_config.material().map_err(ModelError::from)?;
-        let props = props::build_props(&level_config.props, level_config.base_dir.as_deref()).map_err(SceneError::Setup)?;
+        let (fabric, props) = (built.fabric, built.props.to_vec());
         let options = PhysicsOptions {
             membrane: level_config.physics.membrane,
             bending: level_config.physics.bending,
             gravity: if level_config.physics.gravity { DVec3::new(0.0, 0.0, -STANDARD_GRAVITY) } else { DVec3::ZERO },
             damping: level_config.solver.damping,
         };
-        if level_config.scene.kind == SceneKind::Garment {
-            let parts = garment::build(&level_config, &fabric, options)?;
+        let kind = kinds::of(level_config.scene.kind);
+        if kind.specimen() == Specimen::Garment {
+            let own_mesh = level_config.mesh.edge_length == config.mesh.edge_length;
+            let parts = garment::build(&level_config, fabric, options, props, garment.filter(|_| own_mesh))?;
             let integrator = level_config.solver.integrator();
             let steps = (config.scene.duration / level_config.solver.dt).ceil().max(1.0) as u64;
-            let rig = Rig::Garment(Box::new(parts.rig));
+            let rig: Box<dyn Rig> = Box::new(parts.rig);
             let (state, model, props) = (State::at_rest(parts.x), parts.model, parts.props);
             let sample_every = (steps / 400).max(1);
             let topology = std::sync::Arc::new(Topology::of(&model));
-            return Ok(Self { state, config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: Some(parts.sewing), deadline: None, topology, plan_choices: Vec::new() });
+            return Ok(Self { state, config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, level_solver: level_config.solver, garment: Some(parts.sewing), deadline: None, topology, plan_choices: Vec::new() });
         }
         let c = &level_config.cloth;
         let warp = c.warp_angle_deg.to_radians();
-        let drape = level_config.scene.kind == SceneKind::Drape;
-        let (mesh, clamp_band) = if drape { (drape_mesh(&level_config)?, 0.0) } else { strip_mesh(&level_config)? };
+        let drape = kind.specimen() == Specimen::Sheet;
+        let (mesh, clamp_band) = match kind.specimen() {
+            Specimen::Strip { clamped, grip } => strip_mesh(&level_config, clamped, grip)?,
+            _ => (drape_mesh(&level_config)?, 0.0),
+        };
         if let Some(available) = memory::available_bytes() {
             memory::check(mesh.rest.len(), level_config.mesh.edge_length, level_config.solver.newton.preconditioner, available).map_err(SceneError::Setup)?;
         }
-        let mut model = Model::new(&mesh, &fabric, warp, options)?;
+        let mut model = Model::new(&mesh, fabric, warp, options)?;
         let origin = DVec3::from_array(c.position);
-        let mut x: Vec<DVec3> = match level_config.test.swing_amplitude.filter(|_| level_config.scene.kind == SceneKind::Swing) {
-            Some(amplitude) => swing::hanging_positions(&mesh.rest, origin, c.length, amplitude),
-            None => mesh.rest.iter().map(|p| origin + DVec3::new(p.x, p.y, 0.0)).collect(),
-        };
-        let rig = Rig::attach(&level_config, &mut model, &x, clamp_band)?;
+        let mut x = kind.start(&level_config, &mesh.rest);
+        let rig = kind.attach(&level_config, &mut model, &x, clamp_band)?;
         if let Some(amplitude) = level_config.test.perturbation {
             let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(level_config.scene.seed);
             if drape {
@@ -148,7 +178,7 @@ impl Scene {
         let steps = (config.scene.duration / level_config.solver.dt).ceil().max(1.0) as u64;
         let sample_every = (steps / 400).max(1);
         let topology = std::sync::Arc::new(Topology::of(&model));
-        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, garment: None, deadline: None, topology, plan_choices: Vec::new() })
+        Ok(Self { state: State::at_rest(x), config, model, integrator, rig, props, sample_every, levels: None, level_edge: edge_length, level_solver: level_config.solver, garment: None, deadline: None, topology, plan_choices: Vec::new() })
     }
 
     /// Changes the time step (s) and integrator, keeping positions, velocities, time and
@@ -164,7 +194,8 @@ impl Scene {
         // A step set in the window is the user's: the plan keeps it.
         self.config.origins.record("solver.dt", crate::settings::Origin::User);
         self.config.origins.record("solver.integrator", crate::settings::Origin::User);
-        let mut integrator = plan::level(&self.config, self.level_edge).solver.integrator();
+        self.level_solver = plan::level(&self.config, self.level_edge).solver;
+        let mut integrator = self.level_solver.integrator();
         integrator.contact_stats = self.integrator.contact_stats;
         self.integrator = integrator;
         self.state.clear_history();
@@ -232,11 +263,11 @@ impl Scene {
 
 /// A rectangular strip for the laboratory tests. Strips clamped at one end carry a clamp
 /// band behind x = 0, a whole number of cells long, and the mesh is made at the exact
-/// column spacing so that a column of vertices lies on the clamp line. Returns the mesh and
-/// the clamp band's length.
-fn strip_mesh(config: &SceneConfig) -> Result<(Mesh, f64), SceneError> {
+/// column spacing so that a column of vertices lies on the clamp line; a strip with a
+/// `grip` has as long a band beyond its far end. Returns the mesh and the clamp band's
+/// length.
+fn strip_mesh(config: &SceneConfig, clamped: bool, grip: bool) -> Result<(Mesh, f64), SceneError> {
     let (c, h) = (&config.cloth, config.mesh.edge_length);
-    let clamped = matches!(config.scene.kind, SceneKind::Cantilever | SceneKind::Arc | SceneKind::Swing);
     let (clamp_band, spacing) = if clamped {
         let cells = (c.length / h).round().max(1.0);
         let spacing = c.length / cells;
@@ -246,7 +277,7 @@ fn strip_mesh(config: &SceneConfig) -> Result<(Mesh, f64), SceneError> {
         (0.0, h)
     };
     // The arc also has a grip band beyond the free length.
-    let grip_band = if config.scene.kind == SceneKind::Arc { clamp_band } else { 0.0 };
+    let grip_band = if grip { clamp_band } else { 0.0 };
     let mut mesh = Mesh::rectangle(c.length + clamp_band + grip_band, c.width, spacing, config.mesh.pattern, config.scene.seed)
         .map_err(ModelError::from)?;
     for p in &mut mesh.rest {

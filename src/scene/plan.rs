@@ -17,7 +17,8 @@
 //! ```
 
 use crate::settings::{Origin, SolverPath};
-use super::{SceneConfig, SceneError, SceneKind};
+use super::kinds::Specimen;
+use super::{SceneConfig, SceneError};
 use crate::physics::{bending_length, weight_per_area};
 use crate::sim::PreconditionerChoice;
 use std::fmt::Write as _;
@@ -27,7 +28,7 @@ use std::fmt::Write as _;
 /// whose error against the exact path is within the scatter of its folds (docs/fast-path.md)
 /// and which a designer would otherwise wait several times as long for; else the scene's.
 pub fn opening_path(config: &SceneConfig) -> SolverPath {
-    if config.origins.by_user("solver.path") || config.scene.kind != SceneKind::Garment {
+    if config.origins.by_user("solver.path") || super::kinds::of(config.scene.kind).specimen() != Specimen::Garment {
         config.solver.path
     } else {
         SolverPath::Fast
@@ -149,15 +150,8 @@ pub struct RunPlan {
 impl RunPlan {
     /// The plan of `config`'s run. Refuses a path the integrator cannot take.
     pub fn resolve(config: &SceneConfig) -> Result<Self, SceneError> {
-        let solver = &config.solver;
+        // An explicit integrator on a fast design is refused by the checks (`check::checked`).
         let design = design(config);
-        if design != Design::Exact && solver.integrator.is_explicit() {
-            return Err(SceneError::Setup(
-                "solver.path = \"fast\" takes implicit steps, which solver.integrator = \"symplectic-euler\" cannot; \
-                 use solver.integrator = \"implicit-euler\" or solver.path = \"exact\""
-                    .into(),
-            ));
-        }
         let own = config.mesh.edge_length;
         let edges = match design {
             Design::Exact => {
@@ -242,11 +236,11 @@ fn key_name<T: serde::Serialize>(value: &T) -> String {
 }
 
 /// The design `config` runs on.
-fn design(config: &SceneConfig) -> Design {
+pub(crate) fn design(config: &SceneConfig) -> Design {
     if config.solver.path != SolverPath::Fast {
         return Design::Exact;
     }
-    if config.scene.kind == SceneKind::Garment {
+    if super::kinds::of(config.scene.kind).specimen() == Specimen::Garment {
         return Design::Garment;
     }
     match (config.scene.settle_speed.is_some(), quasi_static(config)) {
@@ -271,7 +265,7 @@ const FAST_MAX_ITERATIONS: usize = 80;
 /// moves freely throughout), or props with gravity ramped up (a lowered specimen).
 /// Otherwise the cloth is dropped onto its props, or swings, and is in motion at every step.
 fn quasi_static(config: &SceneConfig) -> bool {
-    let free_motion = config.scene.kind == SceneKind::Swing;
+    let free_motion = super::kinds::of(config.scene.kind).moves_freely();
     (config.props.is_empty() && !free_motion) || config.scene.gravity_ramp.is_some()
 }
 
@@ -433,7 +427,7 @@ mod tests {
         let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
         let (config, _) = load_scene(preset, &overrides).unwrap();
         let plan = RunPlan::resolve(&config).unwrap();
-        (config, plan)
+        (config.into_config(), plan)
     }
 
     #[test]
@@ -469,7 +463,7 @@ mod tests {
 
     #[test]
     fn cloth_in_motion_keeps_its_mesh_at_the_step_for_motion_with_the_penalty_rescaled() {
-        let (mut config, _) = load_scene("sphere-drop", &["solver.path=fast".into()]).unwrap();
+        let mut config = load_scene("sphere-drop", &["solver.path=fast".into()]).unwrap().0.into_config();
         config.scene.settle_speed = None;
         let dropped = RunPlan::resolve(&config).unwrap();
         assert_eq!(dropped.design, Design::Motion);

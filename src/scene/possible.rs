@@ -3,14 +3,14 @@
 //! physically possible.
 //!
 //! Before the run: a test's extent (strain, end shortening, shear angle) must be reached
-//! within the scene's duration (`settings::validate::check_motion_fits`, checked on loading); props must start clear of the cloth
+//! within the scene's duration (`scene::check::check_motion_fits`, checked on loading); props must start clear of the cloth
 //! ([`check_start`]); a screenshot's camera must leave the cloth some pixels
 //! ([`check_camera`]). After it ([`judge`]): a drape coefficient outside [0, 1] is not a
 //! drape coefficient and is reported as not measured; wrinkles no taller than the seeded
 //! perturbation are the seed, not wrinkles; a motion the run ended before finishing (a
 //! short `--duration`) is said in the metrics' notes.
 
-use crate::settings::validate::motion_time;
+use crate::scene::check::motion_time;
 use crate::settings::SceneConfig;
 use super::{Measures, Metrics, Scene};
 use crate::io::number::short;
@@ -205,7 +205,7 @@ const INSIDE_LAYERS: f64 = 3.0;
 /// layer allows. A garment's measures are those of a garment on its form; anything else
 /// is said, not measured.
 pub fn off_form(scene: &Scene) -> Option<String> {
-    let super::Rig::Garment(rig) = &scene.rig else { return None };
+    let Some(rig) = scene.rig.as_any().downcast_ref::<super::garment::rig::GarmentRig>() else { return None };
     let x = &scene.state.x;
     let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.z), hi.max(p.z)));
     let layer = scene.config.contact.thickness;

@@ -6,7 +6,10 @@
 //!   table;
 //! - [`registry`]: the scenes, fabrics, prop meshes and textures bundled into the binary;
 //! - [`read`]: the one reader of "a bundled name or a file", and `--set` overrides;
-//! - [`validate`]: every value checked before any work, each refusal naming its key.
+//! - [`rule`]: a refused value ([`rule::Invalid`]) and the ranges most keys follow.
+//!
+//! The checks a scene passes before it is built live above this layer, in `scene::check`,
+//! beside the scene kinds they ask.
 //!
 //! Merging a scene with its fabric file and its overrides (`scene::load`) sits above this
 //! layer, since the fabric's measurement sheets are converted on the way.
@@ -15,8 +18,8 @@ pub mod fabric;
 pub mod origin;
 pub mod read;
 pub mod registry;
+pub mod rule;
 pub mod schema;
-pub mod validate;
 
 pub use fabric::FabricConfig;
 pub use origin::{Origin, Origins};

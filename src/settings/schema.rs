@@ -1,6 +1,6 @@
 //! The scene schema: what a scene file may say, section by section, as serde reads it.
 //! Unknown keys are refused (`deny_unknown_fields`), so a typo fails loudly; the values are
-//! checked in [`super::validate`].
+//! checked in `scene::check`.
 
 use super::fabric::FabricConfig;
 use crate::sim::contact::ContactSettings;
@@ -33,19 +33,9 @@ pub enum SceneKind {
 }
 
 impl SceneKind {
-    /// The kind as a scene file names it (`scene.kind`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Tensile => "tensile",
-            Self::Cantilever => "cantilever",
-            Self::Arc => "arc",
-            Self::EulerBuckling => "euler-buckling",
-            Self::ShearBuckling => "shear-buckling",
-            Self::Drape => "drape",
-            Self::Garment => "garment",
-            Self::Swing => "swing",
-        }
-    }
+    /// Every kind, in the order above (what each does: `scene::kinds`).
+    pub const ALL: [SceneKind; 8] =
+        [Self::Tensile, Self::Cantilever, Self::Arc, Self::EulerBuckling, Self::ShearBuckling, Self::Drape, Self::Garment, Self::Swing];
 }
 
 /// A complete scene description, after the fabric file and overrides are merged.

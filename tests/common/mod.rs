@@ -15,7 +15,7 @@ pub fn run(preset: &str, overrides: &[String]) -> (SceneConfig, Metrics) {
     let mut scene = Scene::build(config.clone()).unwrap_or_else(|e| panic!("{e}"));
     let (metrics, error) = run_scene(&mut scene, preset, RunOptions::default());
     assert!(error.is_none(), "{preset} {overrides:?}: {error:?}");
-    (config, metrics)
+    (config.into_config(), metrics)
 }
 
 /// The drape coefficient of a drape scene's run.

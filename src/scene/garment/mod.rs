@@ -16,7 +16,7 @@
 pub mod rig;
 
 use crate::settings::SceneConfig;
-use crate::settings::validate::MAX_SEWING_STIFFNESS;
+use crate::scene::check::MAX_SEWING_STIFFNESS;
 use super::{Scene, SceneError};
 use crate::garment::{self, Garment, form};
 use crate::sim::contact::{ContactModel, Prop, PropShape};
@@ -105,14 +105,19 @@ pub fn build_form(config: &SceneConfig) -> Result<(Prop, Option<form::Measuremen
     Ok((prop, measurements))
 }
 
-/// Builds a garment scene's model, start, props, rig and sewing.
-pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: PhysicsOptions) -> Result<Parts, SceneError> {
+/// Builds a garment scene's model, start, props, rig and sewing, around the scene's
+/// `props` (the form goes first); `meshed` is the pattern the checks meshed, where it is
+/// at this level's edge length (None: meshed here).
+pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: PhysicsOptions, mut props: Vec<Prop>, meshed: Option<Garment>) -> Result<Parts, SceneError> {
     let g = config.garment.as_ref().ok_or_else(|| SceneError::Setup("a garment scene needs a [garment] section".into()))?;
     let metres = g.units.metres();
     let (form, measurements) = build_form(config)?;
     let axis = DVec2::new(g.form.axis[0], g.form.axis[1]) * metres;
     let level = |name: &str| measurements.as_ref()?.level(name);
-    let garment = garment::build(g, config.mesh.edge_length, axis, &level).map_err(|e| SceneError::Setup(e.to_string()))?;
+    let garment = match meshed {
+        Some(garment) => garment,
+        None => garment::build(g, config.mesh.edge_length, axis, &level).map_err(|e| SceneError::Setup(e.to_string()))?,
+    };
     let thickness = config.contact.thickness;
     check_outside(&garment, &form, thickness)?;
     let pairs = garment.seam_pairs();
@@ -134,7 +139,6 @@ pub fn build(config: &SceneConfig, fabric: &crate::sim::Fabric, options: Physics
     model.sewing.start(&x);
     model.sewing.slack = 1.0;
     let mut welded = Model::from_panels(&welded_surface, &[], fabric, options)?;
-    let mut props = super::props::build_props(&config.props, config.base_dir.as_deref()).map_err(SceneError::Setup)?;
     props.insert(0, form);
     let settings = config.contact;
     welded.contact = Some(ContactModel::new(props.clone(), settings).map_err(SceneError::Setup)?);
@@ -422,7 +426,7 @@ impl Scene {
         state.time = earlier.state.time;
         state.steps = earlier.state.steps;
         (sewing.sewn_at, sewing.gap_at_weld) = (before.sewn_at, before.gap_at_weld);
-        if let (super::rigs::Rig::Garment(rig), Some(at), Some(gap)) = (&mut self.rig, before.sewn_at, before.gap_at_weld) {
+        if let (Some(rig), Some(at), Some(gap)) = (self.rig.as_any_mut().downcast_mut::<rig::GarmentRig>(), before.sewn_at, before.gap_at_weld) {
             rig.welded(weld_map, at, gap);
         }
         // The same mesh keeps its version (buffers and drags stay valid) unless its texture
@@ -434,7 +438,7 @@ impl Scene {
             std::sync::Arc::new(super::Topology::merged(&model, &earlier.topology, identity))
         };
         self.integrator = {
-            let mut integrator = super::plan::level(&self.config, self.level_edge).solver.integrator();
+            let mut integrator = self.level_solver.integrator();
             integrator.contact_stats = earlier.integrator.contact_stats;
             integrator
         };
@@ -481,11 +485,11 @@ impl Scene {
         state.v = velocity;
         state.time = self.state.time;
         state.steps = self.state.steps;
-        let mut integrator = super::plan::level(&self.config, self.level_edge).solver.integrator();
+        let mut integrator = self.level_solver.integrator();
         integrator.contact_stats = self.integrator.contact_stats;
         sewing.sewn_at = Some(self.state.time);
         sewing.gap_at_weld = Some(gap);
-        if let super::rigs::Rig::Garment(rig) = &mut self.rig {
+        if let Some(rig) = self.rig.as_any_mut().downcast_mut::<rig::GarmentRig>() {
             rig.welded(weld_map, self.state.time, gap);
         }
         self.topology = std::sync::Arc::new(super::Topology::merged(&model, &self.topology, weld_map.clone()));

@@ -4,75 +4,11 @@
 use super::super::drape;
 use crate::garment::{Garment, form::Measurements};
 use crate::scene::SceneConfig;
+use crate::scene::measures::{GarmentMeasures, Measures};
+use crate::scene::kinds::Rig;
 use crate::sim::contact::Prop;
 use crate::sim::{Model, State};
 use glam::{DVec2, DVec3};
-use serde::{Deserialize, Serialize};
-
-/// A garment's measurements, SI units (m, m², s).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct GarmentMeasures {
-    /// (A_shadow − A_waist) / (A_pattern + A_waist − A_waist): the Cusick drape coefficient
-    /// with the form's section at the waist as the support and the flat pattern around it
-    /// as the specimen (a full-circle skirt's is exactly Cusick's).
-    pub garment_drape_coefficient: f64,
-    /// Height of the hem above the floor: mean, lowest, highest, and its standard
-    /// deviation (the hem's evenness), m.
-    pub hem_height_max: f64,
-    pub hem_height_mean: f64,
-    pub hem_height_min: f64,
-    pub hem_height_spread: f64,
-    /// Folds (nodes) of the shadow's outline around the form's axis.
-    pub hem_nodes: usize,
-    /// Largest and smallest radius of the shadow's outline from the form's axis, m.
-    pub hem_radius_max: f64,
-    pub hem_radius_min: f64,
-    /// Largest distance between a seam's vertex pairs now, m (zero once welded).
-    pub open_seam_gap: f64,
-    /// Pattern pieces, and vertex pairs along the seams.
-    pub panels: usize,
-    /// Area of the flat pattern, m².
-    pub pattern_area: f64,
-    /// Largest distance between seam pairs when they were welded, m.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub seam_gap_at_weld: Option<f64>,
-    pub seam_pairs: usize,
-    /// Per seam: its length along side a now, and the rest lengths of sides a and b, m.
-    pub seams: Vec<[f64; 3]>,
-    /// Whether every seam was closed and welded.
-    pub sewn: bool,
-    /// When the seams were welded, s.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sewn_at: Option<f64>,
-    /// Area of the garment's vertical projection together with the form's waist section, m².
-    pub shadow_area: f64,
-    /// Area of the form's section the drape coefficient is taken against, m².
-    pub waist_area: f64,
-    /// Why the garment is not hanging on its form (slid off, fallen, inside it), where it
-    /// is not: its drape measures are then withheld (null).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub off_form: Option<String>,
-}
-
-impl GarmentMeasures {
-    /// Withholds the measures of a garment hanging on its form, saying why (`reason`).
-    pub fn withhold(&mut self, reason: String) {
-        for value in [
-            &mut self.garment_drape_coefficient,
-            &mut self.hem_height_max,
-            &mut self.hem_height_mean,
-            &mut self.hem_height_min,
-            &mut self.hem_height_spread,
-            &mut self.hem_radius_max,
-            &mut self.hem_radius_min,
-            &mut self.shadow_area,
-        ] {
-            *value = f64::NAN;
-        }
-        self.hem_nodes = 0;
-        self.off_form = Some(reason);
-    }
-}
 
 pub struct GarmentRig {
     centre: DVec2,
@@ -138,7 +74,7 @@ impl GarmentRig {
         self.gap_at_weld = Some(gap);
     }
 
-    pub fn finish(&self, model: &Model, state: &State) -> GarmentMeasures {
+    pub fn measures(&self, model: &Model, state: &State) -> GarmentMeasures {
         let x = &state.x;
         // The shadow of the cloth and the waist section together (the hole the waist leaves
         // in the cloth's own shadow is the support's, as the pedestal's is in Cusick's test).
@@ -187,7 +123,7 @@ impl GarmentRig {
     }
 
     /// The shadow's outline around the form's axis, (angle rad, radius m).
-    pub fn outline(&self, model: &Model, state: &State) -> Vec<(f64, f64)> {
+    pub fn shadow_outline(&self, model: &Model, state: &State) -> Vec<(f64, f64)> {
         drape::shadow(&state.x, &model.triangles, self.centre, 1024).outline
     }
 }
@@ -195,4 +131,16 @@ impl GarmentRig {
 fn polygon_area(points: &[DVec3]) -> f64 {
     let n = points.len();
     (0..n).map(|i| 0.5 * points[i].truncate().perp_dot(points[(i + 1) % n].truncate())).sum::<f64>().abs()
+}
+
+impl Rig for GarmentRig {
+    fn finish(&self, model: &Model, state: &State) -> Measures {
+        Measures::Garment(self.measures(model, state))
+    }
+
+    fn outline(&self, model: &Model, state: &State) -> Option<Vec<(f64, f64)>> {
+        Some(self.shadow_outline(model, state))
+    }
+
+    crate::scene::kinds::any_rig!();
 }

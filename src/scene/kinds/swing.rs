@@ -14,30 +14,69 @@
 //! The strip's rest plane maps to the vertical plane: rest x runs down (−z), rest y across
 //! (+x), and the swing is along +y.
 
-use super::SceneConfig;
-use super::strip::vertices_where;
+use super::{Kind, Rig, Specimen, need};
+use crate::io::number::short;
+use crate::physics::STANDARD_GRAVITY;
 use crate::reference::{hanging_chain_mode, hanging_chain_period};
+use crate::scene::measures::{Measures, SwingMeasures};
+use crate::scene::strip::vertices_where;
+use crate::scene::{SceneConfig, SceneError};
+use crate::settings::rule::{Invalid, invalid};
 use crate::sim::{Model, State};
 use glam::{DVec2, DVec3};
-use serde::{Deserialize, Serialize};
 
-/// What the swing measures.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct SwingMeasures {
-    /// (time s, mean sideways displacement of the free edge m).
-    pub bottom_history: Vec<[f64; 2]>,
-    /// The hanging chain's first-mode period for the strip's length, s.
-    pub chain_period: f64,
-    /// Half periods between the free edge's zero crossings that were measured.
-    pub half_periods: usize,
-    /// The period measured, twice the mean time between zero crossings, s; None with fewer
-    /// than two half periods (a run too short to tell).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub swing_period: Option<f64>,
+pub struct Swing;
+
+impl Kind for Swing {
+    fn name(&self) -> &'static str {
+        "swing"
+    }
+
+    fn specimen(&self) -> Specimen {
+        Specimen::Strip { clamped: true, grip: false }
+    }
+
+    fn test_keys(&self) -> &'static [&'static str] {
+        &["swing_amplitude", "clamp_length"]
+    }
+
+    fn check(&self, c: &SceneConfig, _extent: f64) -> Result<(), Invalid> {
+        let (t, length) = (&c.test, c.cloth.length);
+        let a = need("Swing", "test.swing_amplitude", t.swing_amplitude)?;
+        // The chain's small-amplitude period holds for swings small against the length.
+        if a > 0.1 * length {
+            return Err(invalid(
+                "test.swing_amplitude",
+                format!("test.swing_amplitude = {} m is more than a tenth of the strip's {} m: the swing would not be small; use at most {}", short(a), short(length), short(0.1 * length)),
+            ));
+        }
+        if t.perturbation.is_some() {
+            return Err(invalid("test.perturbation", "test.perturbation has no effect on a swing scene (it starts in the chain's mode); remove it".into()));
+        }
+        Ok(())
+    }
+
+    fn start(&self, config: &SceneConfig, rest: &[DVec2]) -> Vec<DVec3> {
+        let origin = DVec3::from_array(config.cloth.position);
+        hanging_positions(rest, origin, config.cloth.length, config.test.swing_amplitude.unwrap_or(0.0))
+    }
+
+    fn attach(&self, config: &SceneConfig, model: &mut Model, x: &[DVec3], _clamp_band: f64) -> Result<Box<dyn Rig>, SceneError> {
+        Ok(Box::new(SwingRig::attach(config, model, x, STANDARD_GRAVITY)?))
+    }
+
+    /// The period settles as the free edge crosses the plumb line.
+    fn plot_series(&self) -> &'static str {
+        "swing_period"
+    }
+
+    fn moves_freely(&self) -> bool {
+        true
+    }
 }
 
 /// The swing's rig: the free edge's vertices and its samples.
-pub struct Swing {
+struct SwingRig {
     bottom: Vec<u32>,
     /// The sideways coordinate the strip hangs at, m.
     rest_y: f64,
@@ -56,7 +95,7 @@ pub fn hanging_positions(rest: &[DVec2], origin: DVec3, length: f64, amplitude: 
         .collect()
 }
 
-impl Swing {
+impl SwingRig {
     /// Pins the clamp band (rest x ≤ 0) where it hangs and finds the free edge.
     pub fn attach(config: &SceneConfig, model: &mut Model, x: &[DVec3], gravity: f64) -> Result<Self, crate::sim::ModelError> {
         let rest = model.rest.clone();
@@ -72,17 +111,29 @@ impl Swing {
         Ok(Self { bottom, rest_y: config.cloth.position[1], chain_period: hanging_chain_period(length, gravity), samples: Vec::new() })
     }
 
-    pub fn sample(&mut self, state: &State) {
+    fn sample_edge(&mut self, state: &State) {
         let y = self.bottom.iter().map(|&v| state.x[v as usize].y).sum::<f64>() / self.bottom.len() as f64;
         self.samples.push([state.time, y - self.rest_y]);
     }
 
-    pub fn finish(&self) -> SwingMeasures {
+    fn measures(&self) -> SwingMeasures {
         let crossings = zero_crossings(&self.samples);
         let half_periods = crossings.len().saturating_sub(1);
         let swing_period = (half_periods >= 2).then(|| 2.0 * (crossings[crossings.len() - 1] - crossings[0]) / half_periods as f64);
         SwingMeasures { bottom_history: self.samples.clone(), chain_period: self.chain_period, half_periods, swing_period }
     }
+}
+
+impl Rig for SwingRig {
+    fn sample(&mut self, _model: &Model, state: &State) {
+        self.sample_edge(state);
+    }
+
+    fn finish(&self, _model: &Model, _state: &State) -> Measures {
+        Measures::Swing(self.measures())
+    }
+
+    super::any_rig!();
 }
 
 /// The times at which a sampled signal changes sign, interpolated linearly between samples.

@@ -10,11 +10,12 @@ use glam::DVec2;
 /// The stiffest sewing spring a scene may ask for, N/m.
 pub const MAX_SEWING_STIFFNESS: f64 = 1e6;
 
-/// The checks a garment scene passes when it is loaded (`validate::check_scene`): the
+/// The checks a garment scene passes when it is loaded (`check::checked`): the
 /// `[garment]` section, no `[cloth]` keys, the sewing settings, and the pattern itself
 /// (outlines, grains, seams, attachments, meshing). Returns the smallest panel's smaller
-/// side, m.
-pub fn check(c: &SceneConfig) -> Result<f64, Invalid> {
+/// side, m, and the garment meshed at the scene's edge length, which the scene is built
+/// from.
+pub fn check(c: &SceneConfig) -> Result<(f64, garment::Garment), Invalid> {
     let g = c.garment.as_ref().ok_or_else(|| invalid("garment", "a garment scene needs a [garment] section with its panels and form".into()))?;
     let cloth = &c.cloth;
     if cloth.length != 0.0 || cloth.width != 0.0 || cloth.diameter != 0.0 || cloth.warp_angle_deg != 0.0 || cloth.position != [0.0; 3] {
@@ -23,14 +24,18 @@ pub fn check(c: &SceneConfig) -> Result<f64, Invalid> {
     let h = positive("mesh.edge_length", c.mesh.edge_length)?;
     // Springs far stiffer than the cloth they close only make the step's solve
     // ill-conditioned: at the limit a 1 µm gap already pulls with 1 N.
-    positive_at_most("garment.sewing_stiffness", g.sewing_stiffness, MAX_SEWING_STIFFNESS, "a sewing spring's stiffness in N/m; the default is 50")?;
+    let stiffness_bound = format!("a sewing spring's stiffness in N/m; the default is {}", short(garment::default_sewing_stiffness()));
+    positive_at_most("garment.sewing_stiffness", g.sewing_stiffness, MAX_SEWING_STIFFNESS, &stiffness_bound)?;
     positive("garment.sewing_ramp", g.sewing_ramp)?;
     positive("garment.sewing_time", g.sewing_time)?;
     positive_at_most(
         "garment.closed_share",
         g.closed_share,
         1.0,
-        "a seam is welded once its sides are within this share of the contact layer; farther apart they would be welded out of shape; the default is 0.25",
+        &format!(
+            "a seam is welded once its sides are within this share of the contact layer; farther apart they would be welded out of shape; the default is {}",
+            short(garment::default_closed_share())
+        ),
     )?;
     non_negative("garment.sewing_damping", g.sewing_damping)?;
     if !g.seams.is_empty() && g.sewing_ramp >= g.sewing_time {
@@ -70,7 +75,7 @@ pub fn check(c: &SceneConfig) -> Result<f64, Invalid> {
     if h > 0.5 * extent {
         return Err(invalid("mesh.edge_length", format!("mesh.edge_length = {h} m leaves fewer than 2 elements across the smallest panel ({extent:.3} m); use at most {:.4}", 0.5 * extent)));
     }
-    Ok(extent)
+    Ok((extent, garment))
 }
 
 

@@ -3,30 +3,12 @@
 
 use super::Invalid;
 use crate::io::number::short;
-use crate::settings::{SceneConfig, SceneKind, ShearKinematics};
+use crate::settings::SceneConfig;
 
-/// How long the rig's prescribed motion lasts, s, and the test key that sets its extent:
-/// the tensile pull to `test.max_strain`, the Euler approach to `test.end_shortening`, the
-/// shear to `test.shear_angle_deg`. None for rigs without one (the arc's roll takes half
-/// the run by construction) or where a key is missing (refused elsewhere).
+/// How long the rig's prescribed motion lasts, s, and the test key that sets its extent
+/// (`Kind::motion_time`): None for rigs without one or where a key is missing.
 pub fn motion_time(config: &SceneConfig) -> Option<(&'static str, f64)> {
-    let (t, c) = (&config.test, &config.cloth);
-    let speed = t.speed?;
-    match config.scene.kind {
-        SceneKind::Tensile => Some(("test.max_strain", t.max_strain? * c.length / speed)),
-        SceneKind::EulerBuckling => Some(("test.end_shortening", t.end_shortening? * c.length / speed)),
-        SceneKind::ShearBuckling => {
-            let angle = t.shear_angle_deg?.to_radians();
-            let travel = match t.shear_kinematics.unwrap_or_default() {
-                // The grip slides along the warp by width·tan γ.
-                ShearKinematics::Simple => c.width * angle.tan(),
-                // The grip swings through γ on a link of the width.
-                ShearKinematics::Trellis => c.width * angle,
-            };
-            Some(("test.shear_angle_deg", travel / speed))
-        }
-        _ => None,
-    }
+    crate::scene::kinds::of(config.scene.kind).motion_time(config)
 }
 
 /// Refuses a test whose extent the scene's own duration cannot reach: `test.max_strain =

@@ -13,42 +13,15 @@ mod motion;
 pub use garment::MAX_SEWING_STIFFNESS;
 pub use motion::{check_motion_fits, motion_time};
 
-use super::{PropConfig, PropKind, SceneConfig, SceneKind, SolverPath};
+use super::kinds::{self, Specimen};
+use super::plan::RunPlan;
+use crate::sim::Fabric;
+use crate::sim::contact::Prop;
+use crate::settings::{PropConfig, PropKind, SceneConfig, SceneKind, SolverPath};
 use crate::io::number::short;
+pub use crate::settings::rule::{Invalid, invalid, non_negative, positive, positive_at_most};
 use crate::sim::contact::MAX_REACH;
 use crate::sim::mesh::{MAX_VERTICES, planned_vertices};
-
-/// A refused value: its dotted key and why, with the fix.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Invalid {
-    pub key: String,
-    pub message: String,
-    /// Other keys the refused value was weighed against: where the user set one of them
-    /// (`--set test.speed=1e-300` against the scene's `test.max_strain`), the refusal is
-    /// traced to it.
-    pub also: Vec<String>,
-}
-
-pub fn invalid(key: &str, message: String) -> Invalid {
-    Invalid { key: key.to_string(), message, also: Vec::new() }
-}
-
-pub fn positive(key: &str, v: f64) -> Result<f64, Invalid> {
-    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be a positive number, got {}", short(v)))) }
-}
-
-pub fn non_negative(key: &str, v: f64) -> Result<f64, Invalid> {
-    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(invalid(key, format!("{key} must be zero or a positive number, got {}", short(v)))) }
-}
-
-/// Positive and at most `max` (`why` says what the bound is).
-pub fn positive_at_most(key: &str, v: f64, max: f64, why: &str) -> Result<f64, Invalid> {
-    positive(key, v)?;
-    if v > max {
-        return Err(invalid(key, format!("{key} = {} is more than {} ({why})", short(v), short(max))));
-    }
-    Ok(v)
-}
 
 /// A point within the reach of the props' single-precision geometry.
 fn point(key: &str, p: [f64; 3]) -> Result<(), Invalid> {
@@ -81,33 +54,68 @@ pub fn check_step_count(key: &str, duration: f64, dt: f64, max_steps: u64) -> Re
     Ok(())
 }
 
-/// Which scene kinds read each test key: a key another kind would silently ignore is refused.
-const TEST_KEYS: &[(&str, &[SceneKind])] = {
-    use SceneKind::*;
-    &[
-        ("max_strain", &[Tensile]),
-        ("end_shortening", &[EulerBuckling]),
-        ("shear_angle_deg", &[ShearBuckling]),
-        ("speed", &[Tensile, EulerBuckling, ShearBuckling]),
-        ("curvature", &[Arc]),
-        ("clamp_length", &[Cantilever, Arc, Swing]),
-        ("shear_kinematics", &[ShearBuckling]),
-        ("clamp_radius", &[Drape]),
-        ("support_diameter", &[Drape]),
-        ("support_size", &[Drape]),
-        ("swing_amplitude", &[Swing]),
-    ]
-};
-
-/// Checks a whole scene (see the module's doc).
-pub fn check_scene(c: &SceneConfig) -> Result<(), Invalid> {
-    check_scene_for(c, None)
+/// A scene that passed the checks, with what they built on the way: the fabric, the
+/// props, a garment's meshed pattern, and the run plan. Only the checks make one
+/// ([`checked`], [`checked_for`]); it is all `Scene::build` accepts, and it reads as its
+/// settings (`Deref`). A change to the settings goes back through the checks
+/// ([`CheckedScene::into_config`], then `checked` or `Scene::new`).
+#[derive(Clone)]
+pub struct CheckedScene {
+    config: SceneConfig,
+    fabric: Fabric,
+    props: Vec<Prop>,
+    garment: Option<crate::garment::Garment>,
+    plan: RunPlan,
 }
 
-/// [`check_scene`] for a run of `run_duration` seconds (`rosette run --duration`) instead
-/// of the scene's own: the step count and the step's length are checked against it, and
+/// What a checked scene hands `Scene::build`.
+pub(crate) struct Checked {
+    pub config: SceneConfig,
+    pub fabric: Fabric,
+    pub props: Vec<Prop>,
+    pub garment: Option<crate::garment::Garment>,
+    pub plan: RunPlan,
+}
+
+impl CheckedScene {
+    /// How the scene will run: its design and levels, and what the plan chose over the
+    /// scene's settings.
+    pub fn plan(&self) -> &RunPlan {
+        &self.plan
+    }
+
+    /// The settings, to change and check again.
+    pub fn into_config(self) -> SceneConfig {
+        self.config
+    }
+
+    pub(crate) fn into_parts(self) -> Checked {
+        Checked { config: self.config, fabric: self.fabric, props: self.props, garment: self.garment, plan: self.plan }
+    }
+}
+
+impl std::fmt::Debug for CheckedScene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CheckedScene").field("config", &self.config).field("plan", &self.plan).finish_non_exhaustive()
+    }
+}
+
+impl std::ops::Deref for CheckedScene {
+    type Target = SceneConfig;
+    fn deref(&self) -> &SceneConfig {
+        &self.config
+    }
+}
+
+/// Checks a whole scene (see the module's doc).
+pub fn checked(c: SceneConfig) -> Result<CheckedScene, Invalid> {
+    checked_for(c, None)
+}
+
+/// [`checked`] for a run of `run_duration` seconds (`rosette run --duration`) instead of
+/// the scene's own: the step count and the step's length are checked against it, and
 /// named by its flag.
-pub fn check_scene_for(c: &SceneConfig, run_duration: Option<f64>) -> Result<(), Invalid> {
+pub fn checked_for(c: SceneConfig, run_duration: Option<f64>) -> Result<CheckedScene, Invalid> {
     let s = &c.scene;
     positive("scene.duration", s.duration)?;
     let run = match run_duration {
@@ -124,19 +132,20 @@ pub fn check_scene_for(c: &SceneConfig, run_duration: Option<f64>) -> Result<(),
     if s.max_steps == 0 {
         return Err(invalid("scene.max_steps", "scene.max_steps must be at least 1".into()));
     }
-    check_solver(c, &run)?;
+    check_solver(&c, &run)?;
     check_step_count(run.key, run.seconds, c.solver.dt, s.max_steps)?;
-    let extent = if c.scene.kind == SceneKind::Garment {
-        garment::check(c)?
+    let (extent, garment) = if kinds::of(c.scene.kind).specimen() == Specimen::Garment {
+        let (extent, garment) = garment::check(&c)?;
+        (extent, Some(garment))
     } else {
-        let extent = check_cloth(c)?;
-        check_mesh(c, &extent)?;
-        extent.size
+        let extent = check_cloth(&c)?;
+        check_mesh(&c, &extent)?;
+        (extent.size, None)
     };
-    c.material().map_err(|e| invalid(&format!("fabric.{}", e.key()), e.to_string()))?;
+    let fabric = c.material().map_err(|e| invalid(&format!("fabric.{}", e.key()), e.to_string()))?;
     c.fabric.look(c.base_dir.as_deref()).map_err(|e| invalid(&format!("fabric.{}", e.key), e.message))?;
-    check_test(c, extent)?;
-    check_contact(c, extent)?;
+    check_test(&c, extent)?;
+    check_contact(&c, extent)?;
     for (i, p) in c.props.iter().enumerate() {
         check_prop_keys(i, p)?;
         point(&format!("props[{i}].position"), p.position)?;
@@ -144,7 +153,9 @@ pub fn check_scene_for(c: &SceneConfig, run_duration: Option<f64>) -> Result<(),
             return Err(invalid(&format!("props[{i}].rotation_deg"), format!("props[{i}].rotation_deg must be three angles between -360 and 360 degrees, got {:?}", p.rotation_deg)));
         }
     }
-    Ok(())
+    let props = super::props::build_props(&c.props, c.base_dir.as_deref()).map_err(|e| invalid("props", e))?;
+    let plan = RunPlan::resolve(&c).map_err(|e| invalid("solver.path", e.to_string()))?;
+    Ok(CheckedScene { config: c, fabric, props, garment, plan })
 }
 
 /// How long the run is asked to be, and the key or flag that says so.
@@ -196,15 +207,16 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
     if n.max_iterations == 0 {
         return Err(invalid("solver.newton.max_iterations", format!("solver.newton.max_iterations must be at least 1 (default {}): with none, no step is solved", crate::sim::solver::DEFAULT_MAX_ITERATIONS)));
     }
-    for (key, count, default) in [("solver.newton.cg_max_iterations", n.cg_max_iterations, 3000), ("solver.fast.cg_max_iterations", solver.fast.cg_max_iterations, 400)] {
+    let (newton, fast_defaults) = (crate::sim::NewtonSettings::default(), crate::settings::FastSettings::default());
+    for (key, count, default) in [("solver.newton.cg_max_iterations", n.cg_max_iterations, newton.cg_max_iterations), ("solver.fast.cg_max_iterations", solver.fast.cg_max_iterations, fast_defaults.cg_max_iterations)] {
         if count == 0 {
             return Err(invalid(key, format!("{key} must be at least 1 (default {default}): with none, Newton has no direction")));
         }
     }
-    positive_at_most("solver.newton.tolerance", n.tolerance, 0.1, "a tenth of an edge: Newton would stop before it starts; the default is 1e-5")?;
+    positive_at_most("solver.newton.tolerance", n.tolerance, 0.1, &format!("a tenth of an edge: Newton would stop before it starts; the default is {}", short(newton.tolerance)))?;
     positive("solver.newton.cg_tolerance", n.cg_tolerance)?;
     if n.cg_tolerance >= 1.0 {
-        return Err(invalid("solver.newton.cg_tolerance", format!("solver.newton.cg_tolerance = {} must be below 1 (a relative residual; the default is 1e-3)", n.cg_tolerance)));
+        return Err(invalid("solver.newton.cg_tolerance", format!("solver.newton.cg_tolerance = {} must be below 1 (a relative residual; the default is {})", n.cg_tolerance, short(newton.cg_tolerance))));
     }
     if !(n.error_share.is_finite() && (0.0..1.0).contains(&n.error_share)) {
         return Err(invalid(
@@ -212,7 +224,7 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
             format!("solver.newton.error_share = {} must lie in [0, 1): a share of the step's local error (0: off)", short(n.error_share)),
         ));
     }
-    for (key, count, default) in [("solver.newton.recycled_directions", n.recycled_directions, 0), ("solver.fast.recycled_directions", solver.fast.recycled_directions, 8)] {
+    for (key, count, default) in [("solver.newton.recycled_directions", n.recycled_directions, newton.recycled_directions), ("solver.fast.recycled_directions", solver.fast.recycled_directions, fast_defaults.recycled_directions)] {
         if count > MAX_RECYCLED_DIRECTIONS {
             return Err(invalid(
                 key,
@@ -230,10 +242,20 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
         positive_at_most("solver.fast.garment_dt", fast.garment_dt, duration, &format!("{}: a garment's step must fit in the run", run.key))?;
     }
     positive("solver.fast.coarsest_edge_share", fast.coarsest_edge_share)?;
-    for (key, share, default) in [("solver.fast.error_share", fast.error_share, 0.1), ("solver.fast.motion_error_share", fast.motion_error_share, 0.3)] {
+    for (key, share, default) in [("solver.fast.error_share", fast.error_share, fast_defaults.error_share), ("solver.fast.motion_error_share", fast.motion_error_share, fast_defaults.motion_error_share)] {
         if !(share.is_finite() && (0.0..1.0).contains(&share)) {
             return Err(invalid(key, format!("{key} = {} must lie in [0, 1): a share of the step's local error (0: off; default {default})", short(share))));
         }
+    }
+    if solver.integrator.is_explicit() && super::plan::design(c) != super::plan::Design::Exact {
+        return Err(invalid(
+            "solver.integrator",
+            format!(
+                "solver.path = \"fast\" takes implicit steps, which solver.integrator = \"{}\" cannot; \
+                 use solver.integrator = \"implicit-euler\" or solver.path = \"exact\"",
+                solver.integrator
+            ),
+        ));
     }
     if let Some(a) = solver.adaptive.filter(|a| a.enabled) {
         positive("solver.adaptive.tolerance", a.tolerance)?;
@@ -274,7 +296,8 @@ fn check_cloth(c: &SceneConfig) -> Result<Extent, Invalid> {
     }
     point("cloth.position", cloth.position)?;
     let size = |key: &str, v: f64| positive_at_most(key, v, MAX_REACH, "larger than the room contact resolves");
-    let disc = c.scene.kind == SceneKind::Drape && cloth.diameter != 0.0;
+    let sheet = kinds::of(c.scene.kind).specimen() == Specimen::Sheet;
+    let disc = sheet && cloth.diameter != 0.0;
     if disc {
         let d = size("cloth.diameter", cloth.diameter)?;
         for (key, v) in [("cloth.length", cloth.length), ("cloth.width", cloth.width)] {
@@ -287,7 +310,7 @@ fn check_cloth(c: &SceneConfig) -> Result<Extent, Invalid> {
     if cloth.diameter != 0.0 {
         return Err(invalid("cloth.diameter", "cloth.diameter is read by drape scenes only; this scene's cloth is the rectangle cloth.length × cloth.width".into()));
     }
-    if c.scene.kind == SceneKind::Drape && (cloth.length == 0.0 || cloth.width == 0.0) {
+    if sheet && (cloth.length == 0.0 || cloth.width == 0.0) {
         return Err(invalid(
             "cloth.diameter",
             "a drape cloth needs cloth.diameter (a disc) or cloth.length and cloth.width (a rectangle), in metres".into(),
@@ -319,7 +342,7 @@ fn check_mesh(c: &SceneConfig, extent: &Extent) -> Result<(), Invalid> {
     // The mesh generators refuse past their vertex cap too, but only after the fabric (whose
     // buckling branch divides by the edge length squared) has been checked.
     let cloth = &c.cloth;
-    let disc = c.scene.kind == SceneKind::Drape && cloth.diameter != 0.0;
+    let disc = kinds::of(c.scene.kind).specimen() == Specimen::Sheet && cloth.diameter != 0.0;
     let planned = |h: f64| {
         if disc { planned_vertices(cloth.diameter, None, h, c.mesh.pattern) } else { planned_vertices(cloth.length, Some(cloth.width), h, c.mesh.pattern) }
     };
@@ -339,7 +362,8 @@ fn check_mesh(c: &SceneConfig, extent: &Extent) -> Result<(), Invalid> {
 }
 
 fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
-    let (t, kind) = (&c.test, c.scene.kind);
+    let t = &c.test;
+    let kind = kinds::of(c.scene.kind);
     let given = [
         ("max_strain", t.max_strain.is_some()),
         ("end_shortening", t.end_shortening.is_some()),
@@ -353,16 +377,12 @@ fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
         ("support_size", t.support_size.is_some()),
         ("swing_amplitude", t.swing_amplitude.is_some()),
     ];
-    for (key, kinds) in TEST_KEYS {
-        if given.iter().any(|(k, set)| k == key && *set) && !kinds.contains(&kind) {
-            let key = format!("test.{key}");
-            return Err(invalid(&key, format!("{key} has no effect on a {kind:?} scene (it is read by {kinds:?} scenes); remove it")));
-        }
+    // A key another kind would read is refused here, where this kind would ignore it.
+    if let Some((key, _)) = given.iter().find(|(key, set)| *set && !kind.test_keys().contains(key)) {
+        let readers: Vec<SceneKind> = SceneKind::ALL.into_iter().filter(|k| kinds::of(*k).test_keys().contains(key)).collect();
+        let key = format!("test.{key}");
+        return Err(invalid(&key, format!("{key} has no effect on a {:?} scene (it is read by {readers:?} scenes); remove it", c.scene.kind)));
     }
-    let need = |key: &str, v: Option<f64>| -> Result<f64, Invalid> {
-        let v = v.ok_or_else(|| invalid(key, format!("{key} is required for a {kind:?} scene")))?;
-        positive(key, v)
-    };
     let length = c.cloth.length;
     if let Some(a) = t.perturbation {
         non_negative("test.perturbation", a)?;
@@ -373,100 +393,11 @@ fn check_test(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
             return Err(invalid("test.perturbation", format!("test.perturbation = {} m is larger than an element (mesh.edge_length = {} m); use at most {}", short(a), short(h), short(h))));
         }
     }
-    match kind {
-        SceneKind::Tensile => {
-            let strain = need("test.max_strain", t.max_strain)?;
-            if strain > 1.0 {
-                return Err(invalid("test.max_strain", format!("test.max_strain = {} pulls past 100 % strain, where fabrics have long broken; use at most 1", short(strain))));
-            }
-            need("test.speed", t.speed)?;
-        }
-        SceneKind::EulerBuckling => {
-            let s = need("test.end_shortening", t.end_shortening)?;
-            if s >= 0.9 {
-                return Err(invalid("test.end_shortening", format!("test.end_shortening = {} leaves almost no strip; use a fraction below 0.9", short(s))));
-            }
-            need("test.speed", t.speed)?;
-        }
-        SceneKind::ShearBuckling => {
-            let a = need("test.shear_angle_deg", t.shear_angle_deg)?;
-            if a >= 60.0 {
-                return Err(invalid("test.shear_angle_deg", format!("test.shear_angle_deg = {} is beyond any fabric's locking angle; use less than 60", short(a))));
-            }
-            need("test.speed", t.speed)?;
-        }
-        SceneKind::Arc => {
-            let k = need("test.curvature", t.curvature)?;
-            // Rolled further the strip would pass through its own clamp.
-            let most = std::f64::consts::TAU / length;
-            if k > most {
-                return Err(invalid("test.curvature", format!("test.curvature = {} 1/m rolls the {} m strip past a full circle; use at most {}", short(k), short(length), short(most))));
-            }
-        }
-        SceneKind::Cantilever | SceneKind::Drape => {}
-        SceneKind::Swing => {
-            let a = need("test.swing_amplitude", t.swing_amplitude)?;
-            // The chain's small-amplitude period holds for swings small against the length.
-            if a > 0.1 * length {
-                return Err(invalid(
-                    "test.swing_amplitude",
-                    format!("test.swing_amplitude = {} m is more than a tenth of the strip's {} m: the swing would not be small; use at most {}", short(a), short(length), short(0.1 * length)),
-                ));
-            }
-            if t.perturbation.is_some() {
-                return Err(invalid("test.perturbation", "test.perturbation has no effect on a swing scene (it starts in the chain's mode); remove it".into()));
-            }
-        }
-        SceneKind::Garment => {
-            if t.perturbation.is_some() {
-                return Err(invalid("test.perturbation", "test.perturbation has no effect on a garment scene (its panels start where their placement puts them); remove it".into()));
-            }
-        }
-    }
+    kind.check(c, extent)?;
     if let Some(v) = t.clamp_length {
         positive_at_most("test.clamp_length", v, length, "the strip's length, cloth.length")?;
     }
-    motion::check_motion_fits(c)?;
-    if kind == SceneKind::Drape {
-        check_support(c, extent)?;
-    }
-    Ok(())
-}
-
-/// The drape's clamp and support: inside the specimen, so that the drape coefficient
-/// (A_shadow − A_support)/(A_specimen − A_support) stays between 0 and 1.
-fn check_support(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
-    let t = &c.test;
-    if c.props.is_empty() {
-        return Err(invalid("props", "a drape scene needs at least one [[props]] table to drape over".into()));
-    }
-    let (cloth, disc) = (&c.cloth, c.cloth.diameter != 0.0);
-    let specimen_area = if disc { std::f64::consts::PI * cloth.diameter.powi(2) / 4.0 } else { cloth.length * cloth.width };
-    if let Some(r) = t.clamp_radius {
-        positive_at_most("test.clamp_radius", r, 0.5 * extent, "the specimen's own radius, which would leave nothing to drape")?;
-    }
-    let support_area = match (t.support_diameter, t.support_size) {
-        (Some(d), _) => {
-            positive_at_most("test.support_diameter", d, extent, "the specimen, whose drape coefficient would then exceed 1")?;
-            std::f64::consts::PI * d * d / 4.0
-        }
-        (None, Some([a, b])) => {
-            let (along_x, along_y) = if disc { (cloth.diameter, cloth.diameter) } else { (cloth.length, cloth.width) };
-            positive_at_most("test.support_size", a, along_x, "the specimen along x, whose drape coefficient would then exceed 1")?;
-            positive_at_most("test.support_size", b, along_y, "the specimen along y, whose drape coefficient would then exceed 1")?;
-            a * b
-        }
-        (None, None) => {
-            return Err(invalid("test.support_diameter", "a drape scene needs test.support_diameter (a pedestal) or test.support_size (a table top), m".into()));
-        }
-    };
-    if support_area >= specimen_area {
-        return Err(invalid(
-            if t.support_diameter.is_some() { "test.support_diameter" } else { "test.support_size" },
-            format!("the support's area {support_area:.4} m² is not smaller than the specimen's {specimen_area:.4} m²: the drape coefficient would have no meaning; use a smaller support"),
-        ));
-    }
-    Ok(())
+    motion::check_motion_fits(c)
 }
 
 fn check_contact(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
@@ -479,7 +410,8 @@ fn check_contact(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
         // pairs by the hundred per vertex.
         positive_at_most("contact.self_thickness", v, c.mesh.edge_length, "an element, mesh.edge_length")?;
     }
-    positive_at_most("contact.stiffness", k.stiffness, 1e6, "the default 100 times ten thousand, where the Newton system loses its digits")?;
+    let default = crate::sim::contact::ContactSettings::default().stiffness;
+    positive_at_most("contact.stiffness", k.stiffness, 1e4 * default, &format!("the default {} times ten thousand, where the Newton system loses its digits", short(default)))?;
     for (name, mu) in [("contact.friction_static", k.friction_static), ("contact.friction_kinetic", k.friction_kinetic)] {
         if mu > 10.0 {
             return Err(invalid(name, format!("{name} = {} is beyond any pair of surfaces (rubber on rubber is about 1); use at most 10", short(mu))));
