@@ -30,6 +30,16 @@ impl ColorMap {
         }
     }
 
+    /// The viewer's name for it, with its symbol and unit.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::WarpStrain => "warp strain ε_x",
+            Self::WeftStrain => "weft strain ε_y",
+            Self::Shear => "shear strain γ",
+            Self::Bending => "curvature |κ| (1/m)",
+        }
+    }
+
     /// The legend's title (the bitmap font has capitals, digits and a few signs).
     pub fn title(self) -> &'static str {
         match self {
