@@ -4,6 +4,7 @@
 
 use super::worker::Snapshot;
 use crate::render::{ColorMap, ScalarField};
+use crate::sim::model::curvature_magnitude;
 
 /// What the cloth's colour shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -46,18 +47,9 @@ impl ColourMap {
 /// The per-vertex field of `map` (triangle values averaged onto vertices), or `None` for a
 /// field the scene does not model (e.g. bending switched off).
 pub fn field(snapshot: &Snapshot, map: ColorMap) -> Option<ScalarField> {
-    let per_triangle: Vec<f32> = match map {
-        ColorMap::WarpStrain | ColorMap::WeftStrain | ColorMap::Shear => {
-            let k = match map {
-                ColorMap::WarpStrain => 0,
-                ColorMap::WeftStrain => 1,
-                _ => 2,
-            };
-            snapshot.triangle_strains.iter().map(|s| s[k]).collect()
-        }
-        ColorMap::Bending => {
-            snapshot.triangle_curvatures.iter().map(|c| (c[0] * c[0] + c[1] * c[1] + 2.0 * c[2] * c[2]).sqrt()).collect()
-        }
+    let per_triangle: Vec<f32> = match map.strain_component() {
+        Some(k) => snapshot.triangle_strains.iter().map(|s| s[k]).collect(),
+        None => snapshot.triangle_curvatures.iter().map(|k| curvature_magnitude(k.map(f64::from)) as f32).collect(),
     };
     let topology = &snapshot.topology;
     if per_triangle.len() != topology.triangles.len() || !topology.fits(&snapshot.positions) {

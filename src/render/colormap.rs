@@ -55,6 +55,17 @@ impl ColorMap {
         !matches!(self, Self::Bending)
     }
 
+    /// The index of a strain map's component in `[ε_warp, ε_weft, γ]`
+    /// ([`crate::sim::Model::triangle_strains`]); `None` for the curvature map.
+    pub fn strain_component(self) -> Option<usize> {
+        match self {
+            Self::WarpStrain => Some(0),
+            Self::WeftStrain => Some(1),
+            Self::Shear => Some(2),
+            Self::Bending => None,
+        }
+    }
+
     /// Row of this map in the renderer's gradient texture.
     pub(crate) fn row(self) -> u32 {
         Self::ALL.iter().position(|m| *m == self).expect("in ALL") as u32
