@@ -19,7 +19,7 @@ fn table(text: &str) -> toml::Table {
 /// Expands a fabric file's text and returns its fabric and warnings.
 fn expand(text: &str) -> Result<(FabricConfig, Vec<String>), String> {
     let mut t = table(text);
-    let warnings = expand_sheets(&mut t).map_err(|e| e.to_string())?;
+    let warnings = expand_sheets(&mut t).map_err(|e| e.to_string())?.warnings;
     let config: FabricConfig = t.try_into().map_err(|e: toml::de::Error| e.to_string())?;
     config.to_fabric().map_err(|e| e.to_string())?;
     Ok((config, warnings))

@@ -2,54 +2,34 @@
 //! thread (`rosette-card`, not the solver's) with a progress bar and a cancel button, then
 //! shown as the page (an egui texture) and its key numbers, and saved as PNG and JSON.
 
-use crate::card::{Made, Progress};
+use super::job::Job;
+use crate::card::Made;
 use crate::settings::FabricConfig;
 use egui::Color32;
-use std::sync::Arc;
-use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// How often the window redraws while a card is being made, so that its bar moves.
 const PROGRESS_REPAINT: Duration = Duration::from_millis(100);
 
-/// A card being made. Dropping it cancels the card and joins the thread.
+/// A card being made, and the fabric's name. Dropping it cancels the card and joins the
+/// thread.
 struct Making {
-    progress: Arc<Progress>,
+    job: Job<Result<Made, String>>,
     fabric: String,
-    started: Instant,
-    thread: Option<JoinHandle<Result<Made, String>>>,
 }
 
 impl Making {
     fn start(fabric: FabricConfig) -> Result<Self, String> {
-        let progress = Arc::new(Progress::default());
-        let shared = Arc::clone(&progress);
         let name = if fabric.name.is_empty() { "fabric".to_string() } else { fabric.name.clone() };
-        let thread = std::thread::Builder::new()
-            .name("rosette-card".into())
-            .spawn(move || crate::card::make(&fabric, "the viewer's fabric", None, &shared).map_err(|e| e.to_string()))
-            .map_err(|e| format!("cannot start the card's thread: {e}"))?;
-        Ok(Self { progress, fabric: name, started: Instant::now(), thread: Some(thread) })
+        let job = Job::start("rosette-card", move |progress| {
+            crate::card::make(&fabric, "the viewer's fabric", None, progress).map_err(|e| e.to_string())
+        })
+        .map_err(|e| format!("cannot start the card's thread: {e}"))?;
+        Ok(Self { job, fabric: name })
     }
 
-    fn finished(&self) -> bool {
-        self.thread.as_ref().is_none_or(JoinHandle::is_finished)
-    }
-
-    fn join(mut self) -> Result<Made, String> {
-        match self.thread.take().expect("joined once").join() {
-            Ok(result) => result,
-            Err(_) => Err("the card failed unexpectedly (its thread panicked)".into()),
-        }
-    }
-}
-
-impl Drop for Making {
-    fn drop(&mut self) {
-        if let Some(thread) = self.thread.take() {
-            self.progress.cancel();
-            let _ = thread.join();
-        }
+    fn join(self) -> Result<Made, String> {
+        self.job.join().unwrap_or_else(|| Err("the card failed unexpectedly (its thread panicked)".into()))
     }
 }
 
@@ -82,7 +62,7 @@ impl CardView {
     /// Asks the card being made to stop after the tests in progress.
     pub fn cancel(&self) {
         if let Some(m) = &self.making {
-            m.progress.cancel();
+            m.job.progress.cancel();
         }
     }
 
@@ -97,11 +77,11 @@ impl CardView {
 
     /// Takes a finished card (or its failure) into the window.
     fn poll(&mut self) {
-        if !self.making.as_ref().is_some_and(Making::finished) {
+        if !self.making.as_ref().is_some_and(|m| m.job.finished()) {
             return;
         }
         let making = self.making.take().expect("checked");
-        let cancelled = making.progress.is_cancelled();
+        let cancelled = making.job.progress.is_cancelled();
         match making.join() {
             Ok(made) => {
                 self.message = made.picture_error.as_ref().map(|e| format!("The drape pictures could not be rendered: {e}"));
@@ -161,20 +141,22 @@ impl CardView {
                 ui.label("No fabric yet.");
             }
             (Some(m), _) => {
-                let cancelling = m.progress.is_cancelled();
+                let progress = &m.job.progress;
+                let cancelling = progress.is_cancelled();
                 ui.horizontal(|ui| {
-                    let text = format!("{}: {} / {} tests, {:.0} s", m.fabric, m.progress.done(), m.progress.total(), m.started.elapsed().as_secs_f64());
-                    ui.add(egui::ProgressBar::new(m.progress.fraction() as f32).desired_width(320.0).text(text));
+                    let seconds = m.job.started.elapsed().as_secs_f64();
+                    let text = format!("{}: {} / {} tests, {seconds:.0} s", m.fabric, progress.done(), progress.total());
+                    ui.add(egui::ProgressBar::new(progress.fraction() as f32).desired_width(320.0).text(text));
                     if ui.add_enabled(!cancelling, egui::Button::new("Cancel")).clicked() {
-                        m.progress.cancel();
+                        progress.cancel();
                     }
                 });
                 if cancelling {
-                    ui.small(format!("Cancelling: waiting for the {} test(s) in progress to end", m.progress.running().len()));
-                } else if let Some(stage) = m.progress.stage() {
+                    ui.small(format!("Cancelling: waiting for the {} test(s) in progress to end", progress.running().len()));
+                } else if let Some(stage) = progress.stage() {
                     ui.small(stage);
                 } else {
-                    for label in m.progress.running() {
+                    for label in progress.running() {
                         ui.small(format!("running: {label}"));
                     }
                 }
@@ -235,6 +217,7 @@ impl CardView {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::time::Instant;
 
     fn frame(ctx: &egui::Context, view: &mut CardView, fabric: &FabricConfig) {
         let input = egui::RawInput { screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1280.0, 800.0))), ..Default::default() };

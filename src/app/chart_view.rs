@@ -6,16 +6,15 @@
 //! labelled in the values themselves.
 
 use crate::chart::data::{AccuracyRow, StabilityRow, parse_accuracy, parse_stability, read_accuracy, read_stability};
-use crate::chart::{ChartError, ChartOptions, ChartReport, Plan, Problem, Progress, StabilityMap, Status};
+use super::job::Job;
+use crate::chart::{ChartError, ChartOptions, ChartReport, Plan, Problem, StabilityMap, Status};
 use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use egui::Color32;
 use egui_plot::{GridMark, Legend, Line, MarkerShape, Plot, PlotPoints, Points};
 use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// The full sweep's tables as committed in `docs/chart` (`rosette chart --out docs/chart`).
 const BUNDLED_ACCURACY: &str = include_str!("../../docs/chart/accuracy.csv");
@@ -46,47 +45,27 @@ impl Source {
 }
 
 /// The quick sweep running on its own thread (`rosette-chart`, which drives the sweep's
-/// pool). Dropping it cancels the sweep and joins the thread.
+/// pool), and where it writes. Dropping it cancels the sweep and joins the thread.
 struct QuickRun {
-    progress: Arc<Progress>,
+    job: Job<Result<ChartReport, ChartError>>,
     out: PathBuf,
-    started: Instant,
-    thread: Option<JoinHandle<Result<ChartReport, ChartError>>>,
 }
 
 impl QuickRun {
     fn start(out: PathBuf) -> Result<Self, String> {
-        let progress = Arc::new(Progress::default());
         // One run per core, as `rosette chart`; the solver thread then shares the cores.
         let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
         let options = ChartOptions { out: out.clone(), quick: true, threads };
-        let shared = Arc::clone(&progress);
-        let thread = std::thread::Builder::new()
-            .name("rosette-chart".into())
-            .spawn(move || crate::chart::run_with_progress(&options, &shared))
+        let job = Job::start("rosette-chart", move |progress| crate::chart::run_with_progress(&options, progress))
             .map_err(|e| format!("cannot start the chart thread: {e}"))?;
-        Ok(Self { progress, out, started: Instant::now(), thread: Some(thread) })
+        Ok(Self { job, out })
     }
 
-    fn finished(&self) -> bool {
-        self.thread.as_ref().is_none_or(JoinHandle::is_finished)
-    }
-
-    /// Waits for the sweep's end (at once when [`Self::finished`]) and returns its result.
-    fn join(mut self) -> Result<ChartReport, String> {
-        let thread = self.thread.take().expect("joined once");
-        match thread.join() {
-            Ok(result) => result.map_err(|e| e.to_string()),
-            Err(_) => Err("the quick chart run failed unexpectedly (its thread panicked)".into()),
-        }
-    }
-}
-
-impl Drop for QuickRun {
-    fn drop(&mut self) {
-        if let Some(thread) = self.thread.take() {
-            self.progress.cancel();
-            let _ = thread.join();
+    /// Waits for the sweep's end (at once when it has finished) and returns its result.
+    fn join(self) -> Result<ChartReport, String> {
+        match self.job.join() {
+            Some(result) => result.map_err(|e| e.to_string()),
+            None => Err("the quick chart run failed unexpectedly (its thread panicked)".into()),
         }
     }
 }
@@ -203,7 +182,7 @@ impl ChartView {
     /// Asks the quick run to stop: runs not yet started are skipped, those in progress end.
     pub fn cancel_quick_run(&self) {
         if let Some(run) = &self.quick {
-            run.progress.cancel();
+            run.job.progress.cancel();
         }
     }
 
@@ -219,11 +198,11 @@ impl ChartView {
 
     /// Takes a finished quick run's tables (or its failure) into the window.
     fn poll_quick_run(&mut self) {
-        if !self.quick.as_ref().is_some_and(QuickRun::finished) {
+        if !self.quick.as_ref().is_some_and(|run| run.job.finished()) {
             return;
         }
         let run = self.quick.take().expect("checked");
-        let (out, cancelled) = (run.out.clone(), run.progress.is_cancelled());
+        let (out, cancelled) = (run.out.clone(), run.job.progress.is_cancelled());
         match run.join() {
             Ok(report) => {
                 self.dir = out.display().to_string();
@@ -283,20 +262,20 @@ impl ChartView {
                 });
             }
             Some(run) => {
-                let (done, total) = (run.progress.done(), run.progress.total());
-                let fraction = if total > 0 { done as f32 / total as f32 } else { 0.0 };
-                let cancelling = run.progress.is_cancelled();
+                let progress = &run.job.progress;
+                let (done, total, fraction) = (progress.done(), progress.total(), progress.fraction() as f32);
+                let cancelling = progress.is_cancelled();
                 ui.horizontal(|ui| {
                     ui.add(
                         egui::ProgressBar::new(fraction)
                             .desired_width(300.0)
-                            .text(format!("{done} / {total} runs, {:.0} s", run.started.elapsed().as_secs_f64())),
+                            .text(format!("{done} / {total} runs, {:.0} s", run.job.started.elapsed().as_secs_f64())),
                     );
                     if ui.add_enabled(!cancelling, egui::Button::new("Cancel")).clicked() {
-                        run.progress.cancel();
+                        progress.cancel();
                     }
                 });
-                let running = run.progress.running();
+                let running = progress.running();
                 if cancelling {
                     ui.small(format!("Cancelling: waiting for the {} run(s) in progress to end", running.len()));
                 } else if total == 0 {
@@ -421,6 +400,7 @@ impl ChartView {
 mod tests {
     use super::*;
     use crate::chart::data::{mark_pareto, write_accuracy, write_stability};
+    use std::time::Instant;
 
     fn frame(ctx: &egui::Context, view: &mut ChartView) {
         let input = egui::RawInput {

@@ -8,7 +8,8 @@
 //!   [`chart_view`]: the speed/accuracy charts of `rosette chart`; [`card_view`]: the
 //!   fabric card of the fabric being edited; [`pin`]: a fabric's result kept beside the live
 //!   one; [`pattern_view`]: a garment's grains and its flat pattern; [`swatch`]: the
-//!   fabric's look beside its editor.
+//!   fabric's look beside its editor; [`job`]: a card or a sweep on a thread of its own,
+//!   with the progress those windows show.
 //! - [`script`]: scripted sessions read and checked; [`session`]: one played in the window
 //!   through the panels' own code.
 pub mod action;
@@ -17,6 +18,7 @@ pub mod card_view;
 pub mod chart_view;
 pub mod colour;
 pub mod files;
+pub mod job;
 pub mod pattern_view;
 pub mod pin;
 pub mod plots;

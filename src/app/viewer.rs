@@ -7,7 +7,7 @@
 
 use super::colour::{self, ColourMap};
 use super::files;
-use crate::render::{self, ColorMap, Frame, PropMesh, RenderOptions, ScalarField};
+use crate::render::{self, Frame, PropMesh, RenderOptions};
 use super::script::Script;
 use super::session::{Control, FrameInput, Session};
 use super::ui::{Action, FileDialog, ViewerUi};
@@ -574,17 +574,6 @@ fn encode_frame(
     gpu.queue.submit(user_buffers.into_iter().chain(std::iter::once(encoder.finish())));
 }
 
-/// The renderer's colour map for the viewer's choice (`None`: the fabric's weave).
-fn render_map(map: ColourMap) -> Option<ColorMap> {
-    match map {
-        ColourMap::Fabric => None,
-        ColourMap::WarpStrain => Some(ColorMap::WarpStrain),
-        ColourMap::WeftStrain => Some(ColorMap::WeftStrain),
-        ColourMap::Shear => Some(ColorMap::Shear),
-        ColourMap::Bending => Some(ColorMap::Bending),
-    }
-}
-
 /// Clears `target` to the background and draws the cloth and props into the view
 /// rectangle left between the panels.
 fn draw_scene(
@@ -652,8 +641,8 @@ fn draw_scene(
 fn snapshot_frame(snapshot: &Snapshot, ui: &ViewerUi) -> Frame {
     let topology = &snapshot.topology;
     let mut frame = Frame::from_cloth(&snapshot.positions, &topology.triangles, &topology.texture, topology.warp_angle);
-    if let (Some(map), Some(field)) = (render_map(ui.colour_map), colour::field(snapshot, ui.colour_map)) {
-        frame.cloth_scalar = Some(ScalarField { map, values: field.values, min: field.min, max: field.max });
+    if let ColourMap::Field(map) = ui.colour_map {
+        frame.cloth_scalar = colour::field(snapshot, map);
     }
     frame.props = snapshot
         .props

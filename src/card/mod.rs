@@ -17,12 +17,11 @@ pub mod page;
 pub mod picture;
 mod suite;
 
+pub use crate::io::progress::Progress;
 pub use suite::{CardRun, compute, drape_config, scene_fabric};
 
 use crate::lab::LabError;
 use serde::{Deserialize, Serialize};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use thiserror::Error;
 
 /// Why a card could not be made.
@@ -334,83 +333,4 @@ pub struct Card {
     /// The sheet's values read back (empty for a fabric given by its keys).
     pub sheet_readback: Vec<SheetValue>,
     pub cost: Cost,
-}
-
-/// How far a card has got, shared with whoever shows it (the CLI's bar, the viewer's
-/// window), and its cancel switch.
-#[derive(Debug, Default)]
-pub struct Progress {
-    total: AtomicUsize,
-    done: AtomicUsize,
-    cancel: AtomicBool,
-    /// The drape's fraction done, as f64 bits (it is the longest test).
-    drape: AtomicU64,
-    running: Mutex<Vec<String>>,
-    /// What the card does after the tests (pictures, page), if it has got there.
-    stage: Mutex<Option<String>>,
-}
-
-impl Progress {
-    pub fn total(&self) -> usize {
-        self.total.load(Ordering::Relaxed)
-    }
-
-    pub fn done(&self) -> usize {
-        self.done.load(Ordering::Relaxed)
-    }
-
-    /// Tests done, counting the drape's part done, over all tests: 0 to 1.
-    pub fn fraction(&self) -> f64 {
-        let total = self.total();
-        if total == 0 {
-            return 0.0;
-        }
-        let drape = f64::from_bits(self.drape.load(Ordering::Relaxed));
-        let drape_running = self.running().iter().any(|r| r.starts_with("drape"));
-        let partial = if drape_running { drape } else { 0.0 };
-        ((self.done() as f64 + partial) / total as f64).min(1.0)
-    }
-
-    /// The tests in progress.
-    pub fn running(&self) -> Vec<String> {
-        self.running.lock().map(|r| r.clone()).unwrap_or_default()
-    }
-
-    /// The stage after the tests, if reached.
-    pub fn stage(&self) -> Option<String> {
-        self.stage.lock().ok().and_then(|s| s.clone())
-    }
-
-    pub fn set_stage(&self, stage: &str) {
-        if let Ok(mut s) = self.stage.lock() {
-            *s = Some(stage.into());
-        }
-    }
-
-    /// Asks the card to stop: tests not yet started are skipped and those in progress end
-    /// (a test cannot be stopped half way: its runs are the laboratory's own).
-    pub fn cancel(&self) {
-        self.cancel.store(true, Ordering::Relaxed);
-    }
-
-    pub fn is_cancelled(&self) -> bool {
-        self.cancel.load(Ordering::Relaxed)
-    }
-
-    fn start(&self, label: &str) {
-        if let Ok(mut r) = self.running.lock() {
-            r.push(label.into());
-        }
-    }
-
-    fn finish(&self, label: &str) {
-        if let Ok(mut r) = self.running.lock() {
-            r.retain(|l| l != label);
-        }
-        self.done.fetch_add(1, Ordering::Relaxed);
-    }
-
-    fn set_drape(&self, fraction: f64) {
-        self.drape.store(fraction.to_bits(), Ordering::Relaxed);
-    }
 }

@@ -120,7 +120,8 @@ fn run_job(job: Job, fabric: &FabricConfig, drape: &CheckedScene, progress: &Pro
     Ok(match job {
         Job::Drape => {
             let mut scene = Scene::build(drape.clone()).map_err(|e| CardError::Drape(e.to_string()))?;
-            let mut report = |f: f64| progress.set_drape(f);
+            let label = job.label();
+            let mut report = |f: f64| progress.set_part(&label, f);
             let options = RunOptions { progress: Some(&mut report), ..RunOptions::default() };
             let (metrics, error) = run_scene(&mut scene, DRAPE_SCENE, options);
             if let Some(e) = error {
@@ -195,18 +196,13 @@ fn run_suite(fabric: &FabricConfig, drape: &CheckedScene, progress: &Progress) -
     jobs.push(Job::Shear);
     jobs.extend([Job::Kes(Direction::Warp), Job::Kes(Direction::Weft), Job::BiasPull]);
     jobs.extend(Direction::ALL.map(Job::Bending));
-    progress.total.store(jobs.len(), std::sync::atomic::Ordering::Relaxed);
+    progress.set_total(jobs.len());
     let results = parallel_map(&jobs, |&job| {
-        if progress.is_cancelled() {
-            progress.finish("");
-            return None;
-        }
-        let label = job.label();
-        progress.start(&label);
-        let started = Instant::now();
-        let outcome = run_job(job, fabric, drape, progress);
-        progress.finish(&label);
-        Some((outcome, started.elapsed().as_secs_f64()))
+        progress.run(&job.label(), || {
+            let started = Instant::now();
+            let outcome = run_job(job, fabric, drape, progress);
+            (outcome, started.elapsed().as_secs_f64())
+        })
     });
     if progress.is_cancelled() {
         return Err(CardError::Cancelled { done: results.iter().flatten().count(), total: jobs.len() });

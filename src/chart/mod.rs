@@ -10,6 +10,7 @@ pub mod data;
 pub mod plot;
 pub mod sweep;
 
+pub use crate::io::progress::Progress;
 pub use data::{AccuracyRow, StabilityRow};
 pub use sweep::{Case, INACCURATE_ERROR, Outcome, Problem, Status, Step};
 
@@ -17,8 +18,6 @@ use crate::settings::SolverPath;
 use crate::sim::IntegratorKind;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -41,66 +40,6 @@ pub struct ChartOptions {
     pub quick: bool,
     /// Runs in parallel (each run is single-threaded).
     pub threads: usize,
-}
-
-/// How far a sweep has got, for a caller watching from another thread (the viewer's
-/// progress bar), and its way to stop the sweep early. Every field is updated by the sweep's
-/// pool threads as runs start and end.
-#[derive(Debug, Default)]
-pub struct Progress {
-    total: AtomicUsize,
-    done: AtomicUsize,
-    cancel: AtomicBool,
-    /// Labels of the runs in progress ([`Case::label`]), in the order they started.
-    running: Mutex<Vec<String>>,
-}
-
-impl Progress {
-    /// Runs in the sweep (0 until it has been planned).
-    pub fn total(&self) -> usize {
-        self.total.load(Ordering::Relaxed)
-    }
-
-    /// Runs finished (or skipped after a cancel).
-    pub fn done(&self) -> usize {
-        self.done.load(Ordering::Relaxed)
-    }
-
-    /// The runs in progress now.
-    pub fn running(&self) -> Vec<String> {
-        self.running.lock().map(|r| r.clone()).unwrap_or_default()
-    }
-
-    /// Asks the sweep to stop: runs not yet started are skipped, those in progress finish,
-    /// and [`run_with_progress`] returns [`ChartError::Cancelled`].
-    pub fn cancel(&self) {
-        self.cancel.store(true, Ordering::Relaxed);
-    }
-
-    pub fn is_cancelled(&self) -> bool {
-        self.cancel.load(Ordering::Relaxed)
-    }
-
-    /// Runs `case` unless the sweep was cancelled, keeping the counts and the list of runs
-    /// in progress.
-    fn run(&self, case: &Case) -> Option<Outcome> {
-        if self.is_cancelled() {
-            self.done.fetch_add(1, Ordering::Relaxed);
-            return None;
-        }
-        let label = case.label();
-        if let Ok(mut running) = self.running.lock() {
-            running.push(label.clone());
-        }
-        let outcome = case.run();
-        if let Ok(mut running) = self.running.lock()
-            && let Some(i) = running.iter().position(|l| *l == label)
-        {
-            running.remove(i);
-        }
-        self.done.fetch_add(1, Ordering::Relaxed);
-        Some(outcome)
-    }
 }
 
 /// What a sweep produced.
@@ -274,8 +213,8 @@ pub fn run_with_progress(options: &ChartOptions, progress: &Progress) -> Result<
         .thread_name(|i| format!("rosette-chart-{i}"))
         .build()
         .expect("a thread pool");
-    progress.total.store(jobs.len(), Ordering::Relaxed);
-    let outcomes: Vec<Option<Outcome>> = pool.install(|| jobs.par_iter().map(|case| progress.run(case)).collect());
+    progress.set_total(jobs.len());
+    let outcomes: Vec<Option<Outcome>> = pool.install(|| jobs.par_iter().map(|case| progress.run(&case.label(), || case.run())).collect());
     if progress.is_cancelled() {
         return Err(ChartError::Cancelled { done: outcomes.iter().flatten().count(), total: jobs.len() });
     }

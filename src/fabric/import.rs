@@ -478,22 +478,35 @@ pub fn derive(sheets: &Sheets, explicit: &toml::Table) -> Result<Import, SheetEr
     Ok(d.out)
 }
 
+/// What [`expand_sheets`] took out of a fabric table and what it put in.
+#[derive(Debug, Clone, Default)]
+pub struct Expanded {
+    /// The sheet sections, as read (empty when the table had none).
+    pub sheets: Sheets,
+    /// The keys the sheets gave, with their sources.
+    pub import: Import,
+    /// Defaults used and disagreements found, one sentence each: the import's own
+    /// warnings and one for each key the table gives otherwise than the sheet.
+    pub warnings: Vec<String>,
+}
+
 /// Replaces the sheet sections (`[kes]`, `[fast]`, `[cantilever]`, `[arcsim]`) of a fabric table by
 /// the fabric keys they give. A key already in the table wins; a warning says so where the
-/// sheet disagrees with it. Returns the warnings (defaults used, disagreements).
-pub fn expand_sheets(table: &mut toml::Table) -> Result<Vec<String>, SheetError> {
+/// sheet disagrees with it.
+pub fn expand_sheets(table: &mut toml::Table) -> Result<Expanded, SheetError> {
     let sheets = Sheets::take(table)?;
     if sheets.is_empty() {
-        return Ok(Vec::new());
+        return Ok(Expanded { sheets, ..Expanded::default() });
     }
     let import = derive(&sheets, table)?;
-    Ok(apply(table, &import))
+    let warnings = apply(table, &import);
+    Ok(Expanded { sheets, import, warnings })
 }
 
 /// Inserts the derived keys into a fabric table that has no sheet sections left; keys
 /// already there win. Returns the import's warnings and one for each key the sheet
 /// disagrees with.
-pub fn apply(table: &mut toml::Table, import: &Import) -> Vec<String> {
+fn apply(table: &mut toml::Table, import: &Import) -> Vec<String> {
     let mut warnings = import.warnings.clone();
     for d in &import.derived {
         match table.get(d.key) {

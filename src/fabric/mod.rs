@@ -20,7 +20,7 @@ pub mod units;
 pub mod write;
 
 pub use derived::{Derived, Import};
-pub use import::{derive, expand_sheets, merge_scene_sheets};
+pub use import::{Expanded, derive, expand_sheets, merge_scene_sheets};
 pub use sheet::{SheetError, SheetKind, Sheets};
 
 use crate::settings::read::{PresetError, PresetKind, read_preset, refuse_fabric_preset};
@@ -70,9 +70,7 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<LoadedFabric, LoadError> {
 /// A fabric file's table read: sheets converted, keys checked.
 fn from_table(mut table: toml::Table, file: &str) -> Result<LoadedFabric, LoadError> {
     let sheet_error = |source| LoadError::Sheet { file: file.into(), source: Box::new(source) };
-    let sheets = Sheets::take(&mut table).map_err(sheet_error)?;
-    let import = if sheets.is_empty() { Import::default() } else { derive(&sheets, &table).map_err(sheet_error)? };
-    let warnings = import::apply(&mut table, &import);
+    let Expanded { sheets, import, warnings } = expand_sheets(&mut table).map_err(sheet_error)?;
     if let Some(look) = table.get("appearance") {
         crate::appearance::from_value(look).map_err(|e| invalid(file, e.message))?;
     }

@@ -14,12 +14,15 @@
 //!   quietly, a full disk is reported once with the exit code for a lost output.
 //! - [`number`]: numbers in messages, to a few significant figures.
 //! - [`interrupt`]: Ctrl-C and SIGTERM as a request to stop a run at the end of a step.
+//! - [`progress`]: how far a long job (a card, a chart's sweep) has got, shared with whoever
+//!   shows it, and its cancel switch.
 //!
 //! docs/robustness.md is the user's account of all of it.
 
 pub mod guard;
 pub mod interrupt;
 pub mod number;
+pub mod progress;
 pub mod read;
 pub mod stdout;
 pub mod write;

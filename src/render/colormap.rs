@@ -30,6 +30,16 @@ impl ColorMap {
         }
     }
 
+    /// The viewer's name for it, with its symbol and unit.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::WarpStrain => "warp strain ε_x",
+            Self::WeftStrain => "weft strain ε_y",
+            Self::Shear => "shear strain γ",
+            Self::Bending => "curvature |κ| (1/m)",
+        }
+    }
+
     /// The legend's title (the bitmap font has capitals, digits and a few signs).
     pub fn title(self) -> &'static str {
         match self {
@@ -43,6 +53,17 @@ impl ColorMap {
     /// Signed fields use a diverging scale centred on zero; magnitudes a sequential one.
     pub fn signed(self) -> bool {
         !matches!(self, Self::Bending)
+    }
+
+    /// The index of a strain map's component in `[ε_warp, ε_weft, γ]`
+    /// ([`crate::sim::Model::triangle_strains`]); `None` for the curvature map.
+    pub fn strain_component(self) -> Option<usize> {
+        match self {
+            Self::WarpStrain => Some(0),
+            Self::WeftStrain => Some(1),
+            Self::Shear => Some(2),
+            Self::Bending => None,
+        }
     }
 
     /// Row of this map in the renderer's gradient texture.

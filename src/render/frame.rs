@@ -4,6 +4,7 @@ use super::colormap::{ColorMap, ScalarField};
 use crate::appearance::Look;
 use crate::scene::Scene;
 use crate::sim::contact::props::PropShape;
+use crate::sim::model::curvature_magnitude;
 use glam::{DVec2, DVec3};
 
 /// Everything one picture needs, in world coordinates (m, z up).
@@ -121,20 +122,9 @@ impl Frame {
 fn scalar_field(scene: &Scene, map: ColorMap) -> ScalarField {
     let model = &scene.model;
     let x = &scene.state.x;
-    let per_triangle: Vec<f32> = match map {
-        ColorMap::WarpStrain | ColorMap::WeftStrain | ColorMap::Shear => {
-            let k = match map {
-                ColorMap::WarpStrain => 0,
-                ColorMap::WeftStrain => 1,
-                _ => 2,
-            };
-            model.triangle_strains(x).iter().map(|s| s[k] as f32).collect()
-        }
-        ColorMap::Bending => model
-            .triangle_curvatures(x)
-            .iter()
-            .map(|k| (k[0] * k[0] + k[1] * k[1] + 2.0 * k[2] * k[2]).sqrt() as f32)
-            .collect(),
+    let per_triangle: Vec<f32> = match map.strain_component() {
+        Some(k) => model.triangle_strains(x).iter().map(|s| s[k] as f32).collect(),
+        None => model.triangle_curvatures(x).into_iter().map(|k| curvature_magnitude(k) as f32).collect(),
     };
     ScalarField::from_triangles(map, &per_triangle, &model.triangles, x.len())
 }

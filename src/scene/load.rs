@@ -225,7 +225,7 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
             crate::fabric::merge_scene_sheets(t, scene_fabric);
         }
         sources.fabric_file = Some(fabric_file.clone());
-        sources.import = expand_sheets(t, fabric_file).map_err(|e| sources.sheet_invalid(fabric_file, &e))?;
+        sources.import = expand_sheets_noting(t, fabric_file).map_err(|e| sources.sheet_invalid(fabric_file, &e))?;
         // The fabric file's own fields are checked here so errors name that file.
         deserialize_named::<FabricConfig>(t.clone()).map_err(|(_, key, message)| {
             let key = if key.is_empty() { key } else { format!("fabric.{key}") };
@@ -236,7 +236,7 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
     let mut table = merge_fabric(table, fabric_table.map(|f| f.1));
     // A scene without a fabric file may carry its own sheets.
     if let Some(fabric) = table.get_mut("fabric").and_then(|v| v.as_table_mut()) {
-        let import = expand_sheets(fabric, &file).map_err(|e| sources.sheet_invalid(&file, &e))?;
+        let import = expand_sheets_noting(fabric, &file).map_err(|e| sources.sheet_invalid(&file, &e))?;
         if !import.derived.is_empty() {
             sources.import = import;
         }
@@ -260,19 +260,15 @@ pub fn load_scene_with(spec: &str, overrides: &[String], flags: &RunFlags) -> Re
     Ok((checked, file))
 }
 
-/// Turns a fabric table's measurement sheets (`[kes]`, `[fast]`, `[cantilever]`) into
-/// fabric keys (crate::fabric); the defaults it had to use are reported on stderr. Returns
-/// what the sheets gave, with their sources.
-fn expand_sheets(table: &mut toml::Table, file: &str) -> Result<Import, crate::fabric::SheetError> {
-    let sheets = crate::fabric::Sheets::take(table)?;
-    if sheets.is_empty() {
-        return Ok(Import::default());
-    }
-    let import = crate::fabric::derive(&sheets, table)?;
-    for w in crate::fabric::import::apply(table, &import) {
+/// Turns a fabric table's measurement sheets into fabric keys ([`crate::fabric::expand_sheets`])
+/// and reports its warnings on stderr, naming `file`. Returns what the sheets gave, with
+/// their sources.
+fn expand_sheets_noting(table: &mut toml::Table, file: &str) -> Result<Import, crate::fabric::SheetError> {
+    let expanded = crate::fabric::expand_sheets(table)?;
+    for w in &expanded.warnings {
         crate::errln!("warning: {file}: {w}");
     }
-    Ok(import)
+    Ok(expanded.import)
 }
 
 /// The scene's table with its `[fabric]` keys laid over the fabric file's.

@@ -180,6 +180,14 @@ impl Model {
     }
 }
 
+/// Curvature magnitude √(κ_xx² + κ_yy² + 2κ_xy²), 1/m, of a triangle's `[κ_xx, κ_yy, κ_xy]`
+/// ([`Model::triangle_curvatures`]). κ_xy is the tensor's off-diagonal entry (half the
+/// engineering twist), which the tensor holds twice, so this is the tensor's Frobenius norm
+/// √(κ₁² + κ₂²): the same in every in-plane frame, warp or not.
+pub fn curvature_magnitude(k: [f64; 3]) -> f64 {
+    (k[0] * k[0] + k[1] * k[1] + 2.0 * k[2] * k[2]).sqrt()
+}
+
 /// ½ Σ Q_ab x_a·x_b, J.
 fn quadratic_energy(q: &ScalarCsr, x: &[DVec3]) -> f64 {
     if x.len() < PARALLEL_TRIANGLES {

@@ -14,6 +14,7 @@ mod stability;
 #[cfg(test)]
 pub(crate) mod tests;
 
+pub use bending::curvature_magnitude;
 pub use membrane::CompressedEdges;
 pub use motion::Motion;
 pub use sewing::{PanelSurface, Sewing, seam_bands};

@@ -197,6 +197,29 @@ fn cylindrical_bending_energy_converges_to_eq3() {
     }
 }
 
+/// A roll of curvature κ across the warp's diagonal reads κ on every interior triangle:
+/// the magnitude counts the twist κ_xy that the roll puts in the warp frame.
+#[test]
+fn a_roll_off_the_warp_reads_its_curvature_magnitude() {
+    let opts = PhysicsOptions { membrane: false, gravity: DVec3::ZERO, ..Default::default() };
+    let kappa = 8.0;
+    let mesh = Mesh::rectangle(0.1, 0.1, 0.005, Pattern::Regular, 11).unwrap();
+    let model = Model::new(&mesh, &test_fabric(), f64::to_radians(30.0), opts).unwrap();
+    let dir = DVec2::from_angle(f64::to_radians(75.0));
+    let x = deformed(&model, |p| {
+        let (s, t) = (p.dot(dir), p.dot(dir.perp()));
+        let along = dir * ((kappa * s).sin() / kappa) + dir.perp() * t;
+        DVec3::new(along.x, along.y, (1.0 - (kappa * s).cos()) / kappa)
+    });
+    let curvatures = model.triangle_curvatures(&x);
+    for t in (0..curvatures.len()).filter(|&t| model.is_interior_triangle(t)) {
+        let k = curvatures[t];
+        assert!(k[2].abs() > 0.1 * kappa, "the roll twists the warp frame: {k:?}");
+        let magnitude = curvature_magnitude(k);
+        assert!((magnitude - kappa).abs() < 0.02 * kappa, "triangle {t}: {magnitude} for {kappa} ({k:?})");
+    }
+}
+
 /// The hinges read zero on every quadratic surface (whose curvature each triangle's fitted
 /// Hessian reproduces), on any triangulation and warp angle, so they leave constant
 /// curvatures to the fitted stencils.
