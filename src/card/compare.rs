@@ -104,7 +104,7 @@ pub fn configs(fabrics: &[String], scene: &str, overrides: &[String]) -> Result<
 
 /// Runs every config (in parallel, one per core) to its end or until it settles.
 pub fn run(fabrics: &[String], configs: Vec<CheckedScene>, progress: &Progress) -> Vec<(Entry, Option<Scene>)> {
-    progress.total.store(configs.len(), std::sync::atomic::Ordering::Relaxed);
+    progress.set_total(configs.len());
     let jobs: Vec<(String, CheckedScene)> = fabrics.iter().cloned().zip(configs).collect();
     parallel_map(&jobs, |(fabric, config)| {
         let started = Instant::now();

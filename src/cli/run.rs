@@ -305,7 +305,7 @@ fn outcome(name: &str, scene: &Scene, metrics: &rosette::scene::Metrics, error: 
             metrics.newton_limit_steps,
             metrics.worst_residual,
             scene.integrator.newton.tolerance,
-            unconverged_advice(&scene)
+            unconverged_advice(scene)
         );
         return ExitCode::from(EXIT_NOT_CONVERGED);
     }

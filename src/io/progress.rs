@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 #[derive(Debug, Default)]
 pub struct Progress {
     /// Items in the job, 0 until it is planned ([`Self::set_total`]).
-    pub(crate) total: AtomicUsize,
+    total: AtomicUsize,
     done: AtomicUsize,
     cancel: AtomicBool,
     /// Labels of the items in progress, in the order they started.

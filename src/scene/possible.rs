@@ -205,7 +205,7 @@ const INSIDE_LAYERS: f64 = 3.0;
 /// layer allows. A garment's measures are those of a garment on its form; anything else
 /// is said, not measured.
 pub fn off_form(scene: &Scene) -> Option<String> {
-    let Some(rig) = scene.rig.as_any().downcast_ref::<super::garment::rig::GarmentRig>() else { return None };
+    let rig = scene.rig.as_any().downcast_ref::<super::garment::rig::GarmentRig>()?;
     let x = &scene.state.x;
     let (low, high) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.z), hi.max(p.z)));
     let layer = scene.config.contact.thickness;
