@@ -138,7 +138,8 @@ fn garment_scene(rng: &mut Pcg64Mcg) -> String {
         writeln!(
             s,
             "]\nplacement = {{ around = \"{}\", angle_deg = {}, distance = {}, height = {} }}",
-            ["cylinder", "plane", "cone"][rng.random_range(0..3)],
+            // Mostly the placements the schema has; one in five a name it refuses.
+            ["plane", "cone", "plane", "cone", "cylinder"][rng.random_range(0..5)],
             rng.random_range(0.0..360.0),
             rng.random_range(2.0..60.0),
             rng.random_range(30.0..160.0)
@@ -170,7 +171,8 @@ fn generated_garment_scenes_end_in_a_documented_way() {
         let name = format!("garment scene {case} (seed 60):\n{text}");
         let planned = rosette(&["run", &file, "--plan"], &dir);
         judge(&name, &planned, &[0, 2], &dir);
-        if planned.code == Some(0) && case % 4 == 0 {
+        // The first few accepted run (each costs a mesh and a model).
+        if planned.code == Some(0) && accepted < 6 {
             accepted += 1;
             let metrics = format!("m-{case}.json");
             let ran = rosette(&["run", &file, "--duration", "0.04", "--max-wall", "20", "--metrics", &metrics, "--step-log", "log.csv", "--force"], &dir);
@@ -178,6 +180,7 @@ fn generated_garment_scenes_end_in_a_documented_way() {
         }
     }
     eprintln!("{accepted} generated garments ran");
+    assert!(accepted > 0, "no generated garment passed its checks and ran: the generator no longer reaches the run");
 }
 
 /// Random GarmentCode specifications: `pattern import` refuses (2) or writes a scene that a
