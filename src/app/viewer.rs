@@ -45,12 +45,7 @@ pub struct ViewerOptions {
 pub fn load_first_scene(spec: &str, overrides: &[String]) -> Result<CheckedScene, String> {
     let (checked, _) = load_scene(spec, overrides).map_err(|e| e.to_string())?;
     let path = crate::scene::plan::opening_path(&checked);
-    if path == checked.solver.path {
-        return Ok(checked);
-    }
-    let mut config = checked.into_config();
-    config.solver.path = path;
-    crate::scene::check::checked(config).map_err(|e| e.message)
+    checked.with_path(path).map_err(|e| e.message)
 }
 
 /// The scene the viewer opens on: the Cusick drape where it exists, else Euler buckling.

@@ -84,6 +84,22 @@ impl CheckedScene {
         &self.plan
     }
 
+    /// The same scene on `path`: only the checks that read the path are made again and the
+    /// plan resolved again; what the checks built is kept (a path does not change the
+    /// fabric, the props or the pattern).
+    pub fn with_path(self, path: SolverPath) -> Result<CheckedScene, Invalid> {
+        if path == self.config.solver.path {
+            return Ok(self);
+        }
+        let mut checked = self;
+        checked.config.solver.path = path;
+        let run = RunLength { seconds: checked.config.scene.duration, key: "scene.duration" };
+        check_fast_steps(&checked.config, &run)?;
+        check_fast_integrator(&checked.config)?;
+        checked.plan = RunPlan::resolve(&checked.config).map_err(|e| invalid("solver.path", e.to_string()))?;
+        Ok(checked)
+    }
+
     /// The settings, to change and check again.
     pub fn into_config(self) -> SceneConfig {
         self.config
@@ -236,27 +252,14 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
     positive("solver.fast.dt", fast.dt)?;
     positive("solver.fast.drop_dt", fast.drop_dt)?;
     positive("solver.fast.garment_dt", fast.garment_dt)?;
-    if solver.path == SolverPath::Fast {
-        positive_at_most("solver.fast.dt", fast.dt, duration, &format!("{}: the fast path's long step must fit in the run", run.key))?;
-        positive_at_most("solver.fast.drop_dt", fast.drop_dt, duration, &format!("{}: a dropped cloth's step must fit in the run", run.key))?;
-        positive_at_most("solver.fast.garment_dt", fast.garment_dt, duration, &format!("{}: a garment's step must fit in the run", run.key))?;
-    }
+    check_fast_steps(c, run)?;
     positive("solver.fast.coarsest_edge_share", fast.coarsest_edge_share)?;
     for (key, share, default) in [("solver.fast.error_share", fast.error_share, fast_defaults.error_share), ("solver.fast.motion_error_share", fast.motion_error_share, fast_defaults.motion_error_share)] {
         if !(share.is_finite() && (0.0..1.0).contains(&share)) {
             return Err(invalid(key, format!("{key} = {} must lie in [0, 1): a share of the step's local error (0: off; default {default})", short(share))));
         }
     }
-    if solver.integrator.is_explicit() && super::plan::design(c) != super::plan::Design::Exact {
-        return Err(invalid(
-            "solver.integrator",
-            format!(
-                "solver.path = \"fast\" takes implicit steps, which solver.integrator = \"{}\" cannot; \
-                 use solver.integrator = \"implicit-euler\" or solver.path = \"exact\"",
-                solver.integrator
-            ),
-        ));
-    }
+    check_fast_integrator(c)?;
     if let Some(a) = solver.adaptive.filter(|a| a.enabled) {
         positive("solver.adaptive.tolerance", a.tolerance)?;
         positive("solver.adaptive.dt_min", a.dt_min)?;
@@ -277,6 +280,33 @@ fn check_solver(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
                 ),
             ));
         }
+    }
+    Ok(())
+}
+
+/// The fast path's steps fit in the run (the checks that read `solver.path`, with
+/// [`check_fast_integrator`]).
+fn check_fast_steps(c: &SceneConfig, run: &RunLength) -> Result<(), Invalid> {
+    let (fast, duration) = (&c.solver.fast, run.seconds);
+    if c.solver.path == SolverPath::Fast {
+        positive_at_most("solver.fast.dt", fast.dt, duration, &format!("{}: the fast path's long step must fit in the run", run.key))?;
+        positive_at_most("solver.fast.drop_dt", fast.drop_dt, duration, &format!("{}: a dropped cloth's step must fit in the run", run.key))?;
+        positive_at_most("solver.fast.garment_dt", fast.garment_dt, duration, &format!("{}: a garment's step must fit in the run", run.key))?;
+    }
+    Ok(())
+}
+
+/// A fast design takes implicit steps.
+fn check_fast_integrator(c: &SceneConfig) -> Result<(), Invalid> {
+    if c.solver.integrator.is_explicit() && super::plan::design(c) != super::plan::Design::Exact {
+        return Err(invalid(
+            "solver.integrator",
+            format!(
+                "solver.path = \"fast\" takes implicit steps, which solver.integrator = \"{}\" cannot; \
+                 use solver.integrator = \"implicit-euler\" or solver.path = \"exact\"",
+                c.solver.integrator
+            ),
+        ));
     }
     Ok(())
 }
@@ -418,4 +448,25 @@ fn check_contact(c: &SceneConfig, extent: f64) -> Result<(), Invalid> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scene::load_scene;
+    use crate::scene::plan::Design;
+    use crate::settings::SolverPath;
+
+    /// A checked scene moved to another path keeps what its checks built and is planned
+    /// for that path; a path its integrator cannot take is refused naming the key.
+    #[test]
+    fn a_checked_scene_changes_path_through_the_checks_that_read_it() {
+        let (garment, _) = load_scene("skirt-gored-straight", &["solver.path=exact".into()]).unwrap();
+        assert_eq!(garment.plan().design, Design::Exact);
+        let fast = garment.with_path(SolverPath::Fast).unwrap();
+        assert_eq!(fast.plan().design, Design::Garment);
+        assert!(fast.garment.is_some(), "the pattern the checks meshed is kept");
+        let (swing, _) = load_scene("swing", &["solver.integrator=symplectic-euler".into(), "solver.dt=1e-5".into()]).unwrap();
+        let refused = swing.with_path(SolverPath::Fast).unwrap_err();
+        assert_eq!(refused.key, "solver.integrator", "{}", refused.message);
+    }
 }
