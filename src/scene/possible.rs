@@ -10,7 +10,6 @@
 //! perturbation are the seed, not wrinkles; a motion the run ended before finishing (a
 //! short `--duration`) is said in the metrics' notes.
 
-use crate::scene::check::motion_time;
 use crate::settings::SceneConfig;
 use super::{Measures, Metrics, Scene};
 use crate::io::number::short;
@@ -182,13 +181,13 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
     let end = scene.state.time;
     // The time is a sum of steps: a run to a motion's end may fall short of it by round-off.
     let unfinished = !scene.model.motions_finished(end * (1.0 + 1e-9) + 1e-12);
-    if unfinished && metrics.stable {
-        let target = motion_time(config).map_or_else(|| ("test.curvature".to_string(), 0.5 * config.scene.duration), |(k, t)| (k.to_string(), t));
+    let motion = super::kinds::of(config.scene.kind).motion_time(config);
+    if let (true, true, Some(motion)) = (unfinished, metrics.stable, motion) {
         metrics.notes.push(format!(
             "{} not reached: the run covered {} s of the {} s its motion takes (asked for {} s)",
-            target.0,
+            motion.key,
             short(end),
-            short(target.1),
+            short(motion.seconds),
             short(duration)
         ));
     }

@@ -11,7 +11,7 @@ pub mod memory;
 mod motion;
 
 pub use garment::MAX_SEWING_STIFFNESS;
-pub use motion::{check_motion_fits, motion_time};
+pub use motion::check_motion_fits;
 
 use super::kinds::{self, Specimen};
 use super::plan::RunPlan;

@@ -2,31 +2,20 @@
 //! duration.
 
 use super::Invalid;
+use crate::scene::kinds::{self, MotionTime};
 use crate::io::number::short;
 use crate::settings::SceneConfig;
-
-/// How long the rig's prescribed motion lasts, s, and the test key that sets its extent
-/// (`Kind::motion_time`): None for rigs without one or where a key is missing.
-pub fn motion_time(config: &SceneConfig) -> Option<(&'static str, f64)> {
-    crate::scene::kinds::of(config.scene.kind).motion_time(config)
-}
 
 /// Refuses a test whose extent the scene's own duration cannot reach: `test.max_strain =
 /// 0.5` at 1 mm/s on a 10 cm strip needs 50 s, and a 6 s scene would end at 6 % with the
 /// strain asked for nowhere in its results.
 pub fn check_motion_fits(config: &SceneConfig) -> Result<(), Invalid> {
-    let Some((key, needed)) = motion_time(config) else { return Ok(()) };
+    let Some(MotionTime { key, extent: value, seconds: needed }) = kinds::of(config.scene.kind).motion_time(config) else { return Ok(()) };
     let duration = config.scene.duration;
     // The step loop ends within a millionth of a step of the duration.
     if needed <= duration * (1.0 + 1e-9) {
         return Ok(());
     }
-    let value = match key {
-        "test.max_strain" => config.test.max_strain,
-        "test.end_shortening" => config.test.end_shortening,
-        _ => config.test.shear_angle_deg,
-    }
-    .unwrap_or(f64::NAN);
     let speed = config.test.speed.unwrap_or(f64::NAN);
     let also = ["test.speed", "scene.duration", "cloth.length", "cloth.width", "test.shear_kinematics"].map(String::from).to_vec();
     Err(Invalid {

@@ -1,7 +1,7 @@
 //! Pure bending: a clamped strip rolled into an arc by a grip at its far end; the moment
 //! against the curvature gives the bending rigidity.
 
-use super::{Kind, ON_EDGE, Rig, Specimen, clamp_strip, need};
+use super::{Kind, MotionTime, ON_EDGE, Rig, Specimen, clamp_strip, need};
 use crate::io::number::short;
 use crate::scene::measures::{ArcMeasures, Measures};
 use crate::scene::strip::{Columns, fit_circle_radius, vertices_where};
@@ -36,15 +36,20 @@ impl Kind for Arc {
         Ok(())
     }
 
+    /// The grip rolls the strip in over the first half of the run, then holds.
+    fn motion_time(&self, c: &SceneConfig) -> Option<MotionTime> {
+        Some(MotionTime { key: "test.curvature", extent: c.test.curvature?, seconds: 0.5 * c.scene.duration })
+    }
+
     fn attach(&self, config: &SceneConfig, model: &mut Model, x: &[DVec3], clamp_band: f64) -> Result<Box<dyn Rig>, SceneError> {
         let (length, width) = (config.cloth.length, config.cloth.width);
         let (columns, mut rigid) = clamp_strip(config, model, x, clamp_band);
-        // The far grip rolls the strip into an arc of the target curvature over the first
-        // half of the run, then holds while it settles.
+        // The far grip rolls the strip into an arc of the target curvature, then holds
+        // while it settles.
         let grip = vertices_where(&model.rest, |p| p.x > length - ON_EDGE);
         grip.iter().for_each(|&v| rigid[v as usize] = true);
-        let curvature = config.test.curvature.expect("checked when loading");
-        model.drive(&grip, x, Motion::Roll { length, curvature, ramp: 0.5 * config.scene.duration });
+        let roll = self.motion_time(config).expect("checked when loading");
+        model.drive(&grip, x, Motion::Roll { length, curvature: roll.extent, ramp: roll.seconds });
         model.set_clamped_region(&rigid)?;
         Ok(Box::new(ArcRig { columns, length, width, grip }))
     }

@@ -1,7 +1,7 @@
 //! Euler buckling: a strip compressed between pinned ends that approach at a constant speed
 //! (paper Figs. 7–8); the end force against the Euler load and the elastica.
 
-use super::{Kind, ON_EDGE, Rig, Specimen, need};
+use super::{Kind, MotionTime, ON_EDGE, Rig, Specimen, need};
 use crate::io::number::short;
 use crate::scene::measures::{EulerMeasures, Measures};
 use crate::scene::strip::{Columns, count_half_waves, group_force, vertices_where};
@@ -47,8 +47,9 @@ impl Kind for Euler {
         Ok(())
     }
 
-    fn motion_time(&self, c: &SceneConfig) -> Option<(&'static str, f64)> {
-        Some(("test.end_shortening", c.test.end_shortening? * c.cloth.length / c.test.speed?))
+    fn motion_time(&self, c: &SceneConfig) -> Option<MotionTime> {
+        let shortening = c.test.end_shortening?;
+        Some(MotionTime { key: "test.end_shortening", extent: shortening, seconds: shortening * c.cloth.length / c.test.speed? })
     }
 
     fn attach(&self, config: &SceneConfig, model: &mut Model, x: &[DVec3], _clamp_band: f64) -> Result<Box<dyn Rig>, SceneError> {
@@ -57,7 +58,7 @@ impl Kind for Euler {
         let left = vertices_where(&rest, |p| p.x < ON_EDGE);
         let right = vertices_where(&rest, |p| p.x > length - ON_EDGE);
         let speed = config.test.speed.expect("checked when loading");
-        let stop = self.motion_time(config).expect("checked when loading").1;
+        let stop = self.motion_time(config).expect("checked when loading").seconds;
         // Both ends move, each at half the approach speed, so the midspan stays put.
         model.drive(&left, x, Motion::Linear { velocity: DVec3::new(0.5 * speed, 0.0, 0.0), start: 0.0, stop });
         model.drive(&right, x, Motion::Linear { velocity: DVec3::new(-0.5 * speed, 0.0, 0.0), start: 0.0, stop });

@@ -50,6 +50,15 @@ pub enum Specimen {
     Garment,
 }
 
+/// A rig's prescribed motion: the test key that sets its extent, that extent as the
+/// scene gives it, and the seconds the motion takes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionTime {
+    pub key: &'static str,
+    pub extent: f64,
+    pub seconds: f64,
+}
+
 /// What a kind of scene is and does; see the module's doc.
 pub trait Kind: Sync {
     /// The kind as a scene file names it (`scene.kind`).
@@ -69,9 +78,9 @@ pub trait Kind: Sync {
         Ok(())
     }
 
-    /// How long the rig's prescribed motion lasts, s, and the test key that sets its
-    /// extent; None for a rig without one or where a key is missing (refused by `check`).
-    fn motion_time(&self, _config: &SceneConfig) -> Option<(&'static str, f64)> {
+    /// How long the rig's prescribed motion lasts and the test key that sets its extent;
+    /// None for a rig without one or where a key is missing (refused by `check`).
+    fn motion_time(&self, _config: &SceneConfig) -> Option<MotionTime> {
         None
     }
 

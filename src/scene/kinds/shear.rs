@@ -1,7 +1,7 @@
 //! Shear buckling: one edge clamped, the opposite edge moved along the warp (paper Figs.
 //! 9–10); the wrinkles' direction, count and wavelength.
 
-use super::{Kind, ON_EDGE, Rig, Specimen, need, pin_all};
+use super::{Kind, MotionTime, ON_EDGE, Rig, Specimen, need, pin_all};
 use crate::io::number::short;
 use crate::scene::measures::{Measures, ShearMeasures};
 use crate::scene::strip::{count_half_waves, vertices_where};
@@ -35,15 +35,16 @@ impl Kind for Shear {
         Ok(())
     }
 
-    fn motion_time(&self, c: &SceneConfig) -> Option<(&'static str, f64)> {
-        let angle = c.test.shear_angle_deg?.to_radians();
+    fn motion_time(&self, c: &SceneConfig) -> Option<MotionTime> {
+        let degrees = c.test.shear_angle_deg?;
+        let angle = degrees.to_radians();
         let travel = match c.test.shear_kinematics.unwrap_or_default() {
             // The grip slides along the warp by width·tan γ.
             ShearKinematics::Simple => c.cloth.width * angle.tan(),
             // The grip swings through γ on a link of the width.
             ShearKinematics::Trellis => c.cloth.width * angle,
         };
-        Some(("test.shear_angle_deg", travel / c.test.speed?))
+        Some(MotionTime { key: "test.shear_angle_deg", extent: degrees, seconds: travel / c.test.speed? })
     }
 
     fn attach(&self, config: &SceneConfig, model: &mut Model, x: &[DVec3], _clamp_band: f64) -> Result<Box<dyn Rig>, SceneError> {
@@ -51,7 +52,7 @@ impl Kind for Shear {
         let clamped = vertices_where(&model.rest, |p| p.y < ON_EDGE);
         let moving = vertices_where(&model.rest, |p| p.y > width - ON_EDGE);
         let speed = config.test.speed.expect("checked when loading");
-        let stop = self.motion_time(config).expect("checked when loading").1;
+        let stop = self.motion_time(config).expect("checked when loading").seconds;
         pin_all(model, x, &clamped);
         let motion = match config.test.shear_kinematics.unwrap_or_default() {
             // The moving grip slides along the warp; the gap stays, so the cross yarns stretch.

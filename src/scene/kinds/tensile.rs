@@ -1,7 +1,7 @@
 //! The tensile test: an Instron-style strip pull at constant speed (paper Figs. 4–5), the
 //! stress against the extensometer's strain.
 
-use super::{Kind, ON_EDGE, Rig, Specimen, need, pin_all};
+use super::{Kind, MotionTime, ON_EDGE, Rig, Specimen, need, pin_all};
 use crate::scene::measures::{Measures, TensileMeasures};
 use crate::scene::strip::{Columns, group_force, vertices_where};
 use crate::scene::{SceneConfig, SceneError};
@@ -34,8 +34,9 @@ impl Kind for Tensile {
         Ok(())
     }
 
-    fn motion_time(&self, c: &SceneConfig) -> Option<(&'static str, f64)> {
-        Some(("test.max_strain", c.test.max_strain? * c.cloth.length / c.test.speed?))
+    fn motion_time(&self, c: &SceneConfig) -> Option<MotionTime> {
+        let strain = c.test.max_strain?;
+        Some(MotionTime { key: "test.max_strain", extent: strain, seconds: strain * c.cloth.length / c.test.speed? })
     }
 
     fn attach(&self, config: &SceneConfig, model: &mut Model, x: &[DVec3], _clamp_band: f64) -> Result<Box<dyn Rig>, SceneError> {
@@ -44,7 +45,7 @@ impl Kind for Tensile {
         let fixed = vertices_where(&rest, |p| p.x < ON_EDGE);
         let moving = vertices_where(&rest, |p| p.x > length - ON_EDGE);
         let speed = config.test.speed.expect("checked when loading");
-        let stop = self.motion_time(config).expect("checked when loading").1;
+        let stop = self.motion_time(config).expect("checked when loading").seconds;
         pin_all(model, x, &fixed);
         model.drive(&moving, x, Motion::Linear { velocity: DVec3::new(speed, 0.0, 0.0), start: 0.0, stop });
         let columns = Columns::new(&rest, length, h);
