@@ -26,7 +26,7 @@ impl Kind for Arc {
     }
 
     fn check(&self, c: &SceneConfig, _extent: f64) -> Result<(), Invalid> {
-        let k = need("Arc", "test.curvature", c.test.curvature)?;
+        let k = need(self.name(), "test.curvature", c.test.curvature)?;
         // Rolled further the strip would pass through its own clamp.
         let length = c.cloth.length;
         let most = std::f64::consts::TAU / length;

@@ -39,11 +39,11 @@ impl Kind for Euler {
     }
 
     fn check(&self, c: &SceneConfig, _extent: f64) -> Result<(), Invalid> {
-        let s = need("EulerBuckling", "test.end_shortening", c.test.end_shortening)?;
+        let s = need(self.name(), "test.end_shortening", c.test.end_shortening)?;
         if s >= 0.9 {
             return Err(invalid("test.end_shortening", format!("test.end_shortening = {} leaves almost no strip; use a fraction below 0.9", short(s))));
         }
-        need("EulerBuckling", "test.speed", c.test.speed)?;
+        need(self.name(), "test.speed", c.test.speed)?;
         Ok(())
     }
 

@@ -147,7 +147,7 @@ pub trait Rig: Send {
     fn into_any(self: Box<Self>) -> Box<dyn Any>;
 }
 
-/// A test value the kind requires (`kind` as the refusal names it): present and positive.
+/// A test value the kind requires (`kind` as the scene file names it): present and positive.
 fn need(kind: &str, key: &str, v: Option<f64>) -> Result<f64, Invalid> {
     let v = v.ok_or_else(|| invalid(key, format!("{key} is required for a {kind} scene")))?;
     positive(key, v)
@@ -209,6 +209,25 @@ mod tests {
             for key in of(kind).test_keys() {
                 assert!(schema_keys.contains(key), "{name} reads test.{key}, which the schema lacks");
             }
+        }
+    }
+
+    /// A missing test value is refused in the words of the scene file: its key, and the
+    /// kind as `scene.kind` spells it.
+    #[test]
+    fn a_missing_test_value_is_refused_naming_the_kind_as_the_file_does() {
+        for (scene, key) in [("tensile-warp", "test.max_strain"), ("euler-buckling", "test.end_shortening"), ("shear-buckling", "test.shear_angle_deg")] {
+            let (checked, _) = crate::scene::load::load_scene(scene, &[]).unwrap_or_else(|e| panic!("{scene}: {e}"));
+            let mut config = (*checked).clone();
+            match key {
+                "test.max_strain" => config.test.max_strain = None,
+                "test.end_shortening" => config.test.end_shortening = None,
+                _ => config.test.shear_angle_deg = None,
+            }
+            let kind = of(config.scene.kind);
+            let refusal = kind.check(&config, 1.0).expect_err(key);
+            assert_eq!(refusal.key, key);
+            assert_eq!(refusal.message, format!("{key} is required for a {} scene", kind.name()));
         }
     }
 }

@@ -27,11 +27,11 @@ impl Kind for Shear {
     }
 
     fn check(&self, c: &SceneConfig, _extent: f64) -> Result<(), Invalid> {
-        let a = need("ShearBuckling", "test.shear_angle_deg", c.test.shear_angle_deg)?;
+        let a = need(self.name(), "test.shear_angle_deg", c.test.shear_angle_deg)?;
         if a >= 60.0 {
             return Err(invalid("test.shear_angle_deg", format!("test.shear_angle_deg = {} is beyond any fabric's locking angle; use less than 60", short(a))));
         }
-        need("ShearBuckling", "test.speed", c.test.speed)?;
+        need(self.name(), "test.speed", c.test.speed)?;
         Ok(())
     }
 

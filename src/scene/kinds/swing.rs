@@ -42,7 +42,7 @@ impl Kind for Swing {
 
     fn check(&self, c: &SceneConfig, _extent: f64) -> Result<(), Invalid> {
         let (t, length) = (&c.test, c.cloth.length);
-        let a = need("Swing", "test.swing_amplitude", t.swing_amplitude)?;
+        let a = need(self.name(), "test.swing_amplitude", t.swing_amplitude)?;
         // The chain's small-amplitude period holds for swings small against the length.
         if a > 0.1 * length {
             return Err(invalid(

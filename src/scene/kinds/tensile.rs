@@ -26,11 +26,11 @@ impl Kind for Tensile {
     }
 
     fn check(&self, c: &SceneConfig, _extent: f64) -> Result<(), Invalid> {
-        let strain = need("Tensile", "test.max_strain", c.test.max_strain)?;
+        let strain = need(self.name(), "test.max_strain", c.test.max_strain)?;
         if strain > 1.0 {
             return Err(invalid("test.max_strain", format!("test.max_strain = {} pulls past 100 % strain, where fabrics have long broken; use at most 1", short(strain))));
         }
-        need("Tensile", "test.speed", c.test.speed)?;
+        need(self.name(), "test.speed", c.test.speed)?;
         Ok(())
     }
 
