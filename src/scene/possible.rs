@@ -181,8 +181,7 @@ pub fn judge(scene: &Scene, metrics: &mut Metrics, duration: f64) {
     let end = scene.state.time;
     // The time is a sum of steps: a run to a motion's end may fall short of it by round-off.
     let unfinished = !scene.model.motions_finished(end * (1.0 + 1e-9) + 1e-12);
-    let motion = super::kinds::of(config.scene.kind).motion_time(config);
-    if let (true, true, Some(motion)) = (unfinished, metrics.stable, motion) {
+    if unfinished && metrics.stable && let Some(motion) = super::kinds::of(config.scene.kind).motion_time(config) {
         metrics.notes.push(format!(
             "{} not reached: the run covered {} s of the {} s its motion takes (asked for {} s)",
             motion.key,

@@ -216,14 +216,16 @@ mod tests {
     /// kind as `scene.kind` spells it.
     #[test]
     fn a_missing_test_value_is_refused_naming_the_kind_as_the_file_does() {
-        for (scene, key) in [("tensile-warp", "test.max_strain"), ("euler-buckling", "test.end_shortening"), ("shear-buckling", "test.shear_angle_deg")] {
+        type Remove = fn(&mut SceneConfig);
+        let cases: [(&str, &str, Remove); 3] = [
+            ("tensile-warp", "test.max_strain", |c| c.test.max_strain = None),
+            ("euler-buckling", "test.end_shortening", |c| c.test.end_shortening = None),
+            ("shear-buckling", "test.shear_angle_deg", |c| c.test.shear_angle_deg = None),
+        ];
+        for (scene, key, remove) in cases {
             let (checked, _) = crate::scene::load::load_scene(scene, &[]).unwrap_or_else(|e| panic!("{scene}: {e}"));
             let mut config = (*checked).clone();
-            match key {
-                "test.max_strain" => config.test.max_strain = None,
-                "test.end_shortening" => config.test.end_shortening = None,
-                _ => config.test.shear_angle_deg = None,
-            }
+            remove(&mut config);
             let kind = of(config.scene.kind);
             let refusal = kind.check(&config, 1.0).expect_err(key);
             assert_eq!(refusal.key, key);
