@@ -218,11 +218,15 @@ fn an_imported_pattern_on_the_exact_path() {
     garment_loop("pattern-exact", &pattern(), "--exact", "bias");
 }
 
-/// A cloth dropped on a table: it lands and settles, a drag lifts a corner, it settles
-/// again, and the picture shows it.
+/// A cloth dropped on a table: a picture as it lands, held at the time the script waited
+/// for; it settles, a drag lifts a corner, it settles again, and the picture shows it.
 #[test]
 fn a_tablecloth_lands_is_dragged_and_settles() {
-    let script = "[[step]]\nwait = \"settled\"\ntimeout_s = 900\n\
+    let script = "[[step]]\nwait_simulated_s = 0.2\n\
+                  [[step]]\nscreenshot = \"landing.png\"\n\
+                  [[step]]\norbit_deg = [20, 0]\n\
+                  [[step]]\nscreenshot = \"landing-turned.png\"\n\
+                  [[step]]\nwait = \"settled\"\ntimeout_s = 900\n\
                   [[step]]\nframe = true\n\
                   [[step]]\ndrag = { from = [0.5, 0.5], to = [0.5, 0.35], seconds = 0.6 }\n\
                   [[step]]\nwait = \"settled\"\ntimeout_s = 900\n\
@@ -230,6 +234,12 @@ fn a_tablecloth_lands_is_dragged_and_settles() {
                   [[step]]\nquit = true\n";
     let Some(played) = play("tablecloth", "tablecloth", &["--fast", "--set", RED_LOOK], script) else { return };
     assert_eq!(played.code, Some(0), "{}\n{}", played.report["outcome"], played.stderr);
+    // The wait stands the scene at the first step that reaches 0.2 s until a step that needs
+    // it running: both pictures show that moment.
+    let landing = played.step("Screenshot", 0);
+    let (at, dt) = (landing["picture_time_s"].as_f64().unwrap(), landing["last_step"]["dt_s"].as_f64().unwrap());
+    assert!(at >= 0.2 - 1e-9 && at < 0.2 + dt, "{landing}");
+    assert_eq!(played.step("Screenshot", 1)["picture_time_s"].as_f64(), Some(at));
     let first = played.step("Wait { until: Settled", 0);
     let dc = first["measures"]["drape_coefficient"].as_f64().unwrap();
     // A 1 m square over a 0.6 m square table: its shadow lies between the table's and the

@@ -400,3 +400,26 @@ fn a_sewn_garment_re_drapes_in_a_new_fabric_and_grain() {
     assert!(!reloaded.drape.from_sewn);
     assert!(reloaded.sewing.unwrap().sewn_at.is_none(), "a scene opened afresh sews from flat panels");
 }
+
+#[test]
+fn a_hold_pauses_at_the_first_step_that_reaches_its_time_and_play_goes_on_from_there() {
+    // What a script's wait for simulated time does: the scene stands at that moment for the
+    // steps after it, and plays on from it when asked.
+    let config = preset("cantilever");
+    let dt = config.solver.dt;
+    let worker = spawn("cantilever", config);
+    let hold = 0.1;
+    worker.send(Command::HoldAt(hold));
+    let held = worker.wait_for(WAIT, |s| !s.playing && s.steps > 0);
+    assert!(held.time >= hold - 1e-9 && held.time < hold + dt - 1e-9, "held at {} s for {hold} s with steps of {dt} s", held.time);
+    assert_eq!(held.steps, (hold / dt - 1e-6).ceil() as u64);
+    std::thread::sleep(Duration::from_millis(200));
+    assert_eq!(worker.sync(WAIT).steps, held.steps, "a held scene stays where it stopped");
+    // A hold at a time already reached leaves the scene where it is.
+    worker.send(Command::HoldAt(0.5 * hold));
+    let same = worker.sync(WAIT);
+    assert_eq!((same.steps, same.playing), (held.steps, false));
+    worker.send(Command::Play);
+    let resumed = worker.wait_for(WAIT, |s| s.steps > held.steps + 3);
+    assert!(resumed.playing && resumed.time > held.time);
+}

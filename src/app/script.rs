@@ -43,7 +43,8 @@ pub enum WaitFor {
     Settled,
     /// The scene has reached its duration or settled.
     Finished,
-    /// This much simulated time from the step's start, s.
+    /// This much simulated time from the step's start, s: the scene pauses at the first step
+    /// that reaches it and is held there through the steps that only look ([`Action::looks`]).
     Simulated(f64),
     /// This much wall time from the step's start, s.
     Wall(f64),
@@ -105,6 +106,17 @@ pub enum Action {
     Colour(super::colour::ColourMap),
     Screenshot(PathBuf),
     Quit,
+}
+
+impl Action {
+    /// Whether the step only looks at the scene (the camera, the windows, the colours, a
+    /// picture, the pin) and so leaves it held where a wait for simulated time stopped it.
+    pub fn looks(&self) -> bool {
+        matches!(
+            self,
+            Self::Pin | Self::Unpin | Self::Orbit { .. } | Self::Zoom(_) | Self::Frame | Self::Open(_) | Self::Close(_) | Self::Colour(_) | Self::Screenshot(_) | Self::Quit
+        )
+    }
 }
 
 /// A step: its action and the line of the script it came from.

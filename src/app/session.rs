@@ -76,6 +76,13 @@ pub struct Session {
     drag: Option<DragState>,
     /// The screenshot asked for and not yet written.
     screenshot: Option<PathBuf>,
+    /// The simulated time of the last screenshot's picture, s.
+    picture_time: Option<f64>,
+    /// The scene stands still for the session: at t = 0 when the window opens (a script's
+    /// window does not start playing by itself) or where a wait for simulated time paused it
+    /// (`Command::HoldAt`). The steps that only look see that moment; a wait for simulated
+    /// time counts from it; any other step plays the scene again first.
+    holding: bool,
     report: Vec<Value>,
     /// Rounds of the script played (a repeating script).
     round: u64,
@@ -85,7 +92,7 @@ pub struct Session {
 
 impl Session {
     pub fn new(script: Script) -> Self {
-        Self { script, started: Instant::now(), step: 0, step_wall: None, step_simulated: None, drag: None, screenshot: None, report: Vec::new(), round: 0, opened: None }
+        Self { script, started: Instant::now(), step: 0, step_wall: None, step_simulated: None, drag: None, screenshot: None, picture_time: None, holding: true, report: Vec::new(), round: 0, opened: None }
     }
 
     /// Whether the session is feeding the window input (a drag under way): its frames come
@@ -108,6 +115,15 @@ impl Session {
     pub fn frame(&mut self, input: FrameInput) -> Control {
         let Some(step) = self.script.steps.get(self.step).cloned() else { return Control::Quit };
         self.opened.get_or_insert((input.snapshot.positions.len(), input.snapshot.topology.triangles.len()));
+        let simulated_wait = matches!(step.action, Step::Wait { until: WaitFor::Simulated(_), .. });
+        if self.holding && self.step_wall.is_none() && !step.action.looks() && !simulated_wait {
+            self.holding = false;
+            if !matches!(step.action, Step::Pause | Step::Play) {
+                // The step starts once the worker plays again.
+                input.actions.push(Action::Send(Command::Play));
+                return Control::Continue;
+            }
+        }
         let now = Instant::now();
         let step_wall = *self.step_wall.get_or_insert(now);
         let elapsed = now.duration_since(step_wall).as_secs_f64();
@@ -131,7 +147,19 @@ impl Session {
                 if !synced {
                     false
                 } else {
-                    let since = *self.step_simulated.get_or_insert(snapshot.time);
+                    let since = match (self.step_simulated, until) {
+                        (Some(since), _) => since,
+                        (None, WaitFor::Simulated(seconds)) if snapshot.playing || self.holding => {
+                            // Held at the step that reaches the time: the steps after the wait
+                            // see the cloth as it was then. From a held scene the time counts
+                            // from where it is held, so that waits add up exactly.
+                            input.actions.push(Action::Send(Command::HoldAt(snapshot.time + seconds)));
+                            self.holding = true;
+                            self.step_simulated = Some(snapshot.time);
+                            return Control::Continue;
+                        }
+                        (None, _) => *self.step_simulated.insert(snapshot.time),
+                    };
                     match self.wait(*until, snapshot, since, elapsed) {
                         Ok(done) => done,
                         Err((code, message)) => return fail(code, message),
@@ -163,6 +191,7 @@ impl Session {
         if done {
             let details = match (&step.action, self.drag) {
                 (Step::Drag { .. }, Some(d)) => json!({ "held_a_vertex": d.held_vertex }),
+                (Step::Screenshot(_), _) => json!({ "picture_time_s": self.picture_time }),
                 _ => json!({}),
             };
             self.record(&step, snapshot, elapsed, details);
@@ -201,6 +230,16 @@ impl Session {
             WaitFor::Simulated(seconds) => {
                 if snapshot.time >= since + seconds - 1e-9 {
                     true
+                } else if stalled && let Some(settled) = snapshot.settled_at {
+                    return Err((
+                        EXIT_TIMED_OUT,
+                        format!(
+                            "the cloth settled at t = {settled:.3} s and play paused there, short of t = {:.3} s: wait = \"settled\" instead, or add a play step before this wait",
+                            since + seconds
+                        ),
+                    ));
+                } else if stalled && snapshot.finished {
+                    return Err((EXIT_TIMED_OUT, format!("the scene reached its end (t = {:.3} s) short of t = {:.3} s", snapshot.time, since + seconds)));
                 } else if stalled {
                     return Err((EXIT_TIMED_OUT, "the scene is paused, so simulated time does not pass: add a play step first".into()));
                 } else {
@@ -247,11 +286,13 @@ impl Session {
     }
 
     /// The window wrote (or failed to write) the screenshot it was asked for.
-    pub fn saved(&mut self, path: &std::path::Path, result: Result<(), String>) -> Control {
+    /// `time` is the simulated time of the picture, s.
+    pub fn saved(&mut self, path: &std::path::Path, result: Result<(), String>, time: f64) -> Control {
         if self.screenshot.as_deref() != Some(path) {
             return Control::Continue;
         }
         self.screenshot = None;
+        self.picture_time = Some(time);
         match result {
             Ok(()) => Control::Continue,
             Err(e) => Control::Fail(Failure { code: EXIT_NO_OUTPUT, line: self.line(), message: format!("screenshot {} not written: {e}", path.display()) }),

@@ -87,7 +87,11 @@ pub fn run(mut options: ViewerOptions) -> anyhow::Result<u8> {
         let _ = wake.send_event(Wake);
     })))
         .map_err(|e| anyhow!("{spec}: {e}"))?;
-    worker.send(Command::Play);
+    // A script starts the scene itself: its first step that needs it running plays it, so a
+    // wait for simulated time counts from t = 0 (`Session`).
+    if options.script.is_none() {
+        worker.send(Command::Play);
+    }
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
         event_loop.owned_display_handle(),
     )));
@@ -381,7 +385,7 @@ impl App {
                 Err(e) => ui.messages.push(format!("screenshot not saved: {e}")),
             }
             if let (Some(session), Control::Continue) = (&mut self.session, &self.outcome) {
-                self.outcome = session.saved(&path, saved);
+                self.outcome = session.saved(&path, saved, snapshot.time);
             }
         }
         for id in &textures.free {

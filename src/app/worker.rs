@@ -42,6 +42,10 @@ pub enum Command {
     Pause,
     /// Pauses and advances exactly one step.
     Step,
+    /// Plays until simulated time `t` (s) and pauses at the first step that reaches it, as a
+    /// settled cloth pauses: a script's wait for simulated time holds the scene there for
+    /// the steps after it (a screenshot shows that moment, not a later one).
+    HoldAt(f64),
     /// Rebuilds the current scene from its configuration at t = 0, keeping play/pause.
     Reset,
     /// Replaces the fabric and restarts the scene from t = 0 (the cloth drapes again with
@@ -86,6 +90,10 @@ const PUBLISH_INTERVAL: Duration = Duration::from_millis(15);
 /// How far simulated time may fall behind wall time before pacing gives up catching up
 /// (the worker then runs flat out and the real-time factor shows the shortfall), s.
 const MAX_LAG: f64 = 0.1;
+
+/// A step ends on a time held for (`Command::HoldAt`) within this share of the step: the
+/// sum of many steps misses it by rounding.
+const HOLD_SLACK: f64 = 1e-6;
 
 /// Window over which the rates in [`Stats`] are measured.
 const STATS_WINDOW: Duration = Duration::from_secs(1);
@@ -157,12 +165,12 @@ impl DrapeCause {
     }
 }
 
-/// The drape under way, on the wall clock from the click that started it: what a designer
-/// waits for.
+/// The drape under way, on the wall clock from the click that started it, less the time the
+/// scene stood paused: what a designer waits for.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct DrapeClock {
     pub cause: DrapeCause,
-    /// Wall seconds since the click.
+    /// Wall seconds since the click, while the scene played.
     pub wall: f64,
     /// Simulated time when the drape started, s.
     pub started_at: f64,
@@ -381,6 +389,8 @@ struct WorkerState {
     paused_settled: bool,
     /// The user paused (Pause or Step): an edit that rebuilds the scene does not start it.
     user_paused: bool,
+    /// Play pauses at the first step that reaches this simulated time, s (`Command::HoldAt`).
+    hold_at: Option<f64>,
     /// The drape under way: its cause, when it started (wall), and when it was sewn and
     /// settled (simulated s, wall s since the start).
     drape: (DrapeClock, Instant),
@@ -418,6 +428,7 @@ impl WorkerState {
             finished: false,
             paused_settled: false,
             user_paused: false,
+            hold_at: None,
             drape: (DrapeClock::default(), Instant::now()),
             settle,
             error: None,
@@ -442,10 +453,14 @@ impl WorkerState {
             // Wait for a command: indefinitely while paused, until the next step is due
             // while playing.
             let first = if !self.playing {
-                match commands.recv() {
+                let paused = Instant::now();
+                let command = match commands.recv() {
                     Ok(c) => Some(c),
                     Err(_) => return,
-                }
+                };
+                // The drape's clock stands while the scene does (a pause, a script's hold).
+                self.drape.1 += paused.elapsed();
+                command
             } else {
                 let ahead = self.seconds_ahead();
                 if ahead > 0.0 {
@@ -494,6 +509,12 @@ impl WorkerState {
                     self.finished = true;
                     self.playing = false;
                 }
+                if let Some(t) = self.hold_at
+                    && self.scene.state.time >= t - HOLD_SLACK * self.scene.integrator.dt
+                {
+                    self.playing = false;
+                    self.hold_at = None;
+                }
                 if settled && !self.paused_settled {
                     self.paused_settled = true;
                     self.playing = false;
@@ -529,15 +550,24 @@ impl WorkerState {
             Command::Play => {
                 self.playing = true;
                 self.user_paused = false;
+                self.hold_at = None;
                 self.pace = (Instant::now(), self.scene.state.time);
             }
             Command::Pause => {
                 self.playing = false;
                 self.user_paused = true;
+                self.hold_at = None;
+            }
+            Command::HoldAt(t) => {
+                self.user_paused = false;
+                let reached = self.scene.state.time >= t - HOLD_SLACK * self.scene.integrator.dt;
+                (self.playing, self.hold_at) = if reached { (false, None) } else { (true, Some(t)) };
+                self.pace = (Instant::now(), self.scene.state.time);
             }
             Command::Step => {
                 self.playing = false;
                 self.user_paused = true;
+                self.hold_at = None;
                 self.step_once();
             }
             Command::Reset => {
@@ -623,6 +653,7 @@ impl WorkerState {
         self.generation += 1;
         self.finished = false;
         self.paused_settled = false;
+        self.hold_at = None;
         self.drape = (DrapeClock { started_at: self.scene.state.time, ..DrapeClock::default() }, Instant::now());
         self.settle = SettleWatch::new(&self.scene);
         self.error = None;
