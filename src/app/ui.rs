@@ -341,6 +341,10 @@ impl ViewerUi {
         if snapshot.coarse_level {
             ui.small("Fast path: a coarser level of the mesh; the scene's own mesh follows once it settles.");
         }
+        let running = snapshot.stats.step_dt;
+        if snapshot.config.solver.path == SolverPath::Fast && running > 0.0 && (running - snapshot.config.solver.dt).abs() > 1e-9 * running {
+            ui.small(format!("Fast path: steps of {running:.3} s from its plan (`rosette run SCENE --fast --plan`); dt above is the scene's, which the exact path takes."));
+        }
         if integrator.is_explicit() {
             ui.small("Symplectic Euler is stable only below its limit; a diverged step is reported and the last state kept.");
         }
