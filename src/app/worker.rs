@@ -509,9 +509,7 @@ impl WorkerState {
                     self.finished = true;
                     self.playing = false;
                 }
-                if let Some(t) = self.hold_at
-                    && self.scene.state.time >= t - HOLD_SLACK * self.scene.integrator.dt
-                {
+                if self.hold_at.is_some_and(|t| self.reached(t)) {
                     self.playing = false;
                     self.hold_at = None;
                 }
@@ -526,6 +524,11 @@ impl WorkerState {
                 self.publish();
             }
         }
+    }
+
+    /// Whether the scene's time has reached `t` (s), to within steps' rounding.
+    fn reached(&self, t: f64) -> bool {
+        self.scene.state.time >= t - HOLD_SLACK * self.scene.integrator.dt
     }
 
     /// How far simulated time is ahead of wall time since play started, s (negative: behind).
@@ -560,8 +563,7 @@ impl WorkerState {
             }
             Command::HoldAt(t) => {
                 self.user_paused = false;
-                let reached = self.scene.state.time >= t - HOLD_SLACK * self.scene.integrator.dt;
-                (self.playing, self.hold_at) = if reached { (false, None) } else { (true, Some(t)) };
+                (self.playing, self.hold_at) = if self.reached(t) { (false, None) } else { (true, Some(t)) };
                 self.pace = (Instant::now(), self.scene.state.time);
             }
             Command::Step => {
