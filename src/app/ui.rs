@@ -343,7 +343,7 @@ impl ViewerUi {
         }
         let running = snapshot.stats.step_dt;
         if snapshot.config.solver.path == SolverPath::Fast && running > 0.0 && (running - snapshot.config.solver.dt).abs() > 1e-9 * running {
-            ui.small(format!("Fast path: steps of {running:.3} s from its plan (`rosette run SCENE --fast --plan`); dt above is the scene's, which the exact path takes."));
+            ui.small(format!("Fast path: steps of {running:.3} s from its plan (rosette run SCENE --fast --plan); dt above is the scene's, which the exact path takes."));
         }
         if integrator.is_explicit() {
             ui.small("Symplectic Euler is stable only below its limit; a diverged step is reported and the last state kept.");
@@ -533,7 +533,7 @@ impl ViewerUi {
                 ui.end_row();
             };
             row("vertices / triangles", format!("{} / {}", s.vertices, s.triangles));
-            row("integrator, dt", format!("{}, {} s", snapshot.config.solver.integrator, snapshot.config.solver.dt));
+            row("integrator, scene dt", format!("{}, {} s", snapshot.config.solver.integrator, snapshot.config.solver.dt));
             row("steps per second", format!("{:.1}", s.steps_per_second));
             row("step time per 10 ms simulated", format!("{:.3} ms", s.step_ms_per_10ms));
             row("real-time factor", format!("{:.2}", s.real_time_factor));
