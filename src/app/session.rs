@@ -9,7 +9,7 @@
 
 use super::script::{Action as Step, Script, WaitFor, Window};
 use super::ui::{Action, ViewerUi};
-use super::worker::{Command, Snapshot};
+use super::worker::{Command, Snapshot, reached};
 use serde_json::{Value, json};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -228,7 +228,7 @@ impl Session {
             WaitFor::Settled => false,
             WaitFor::Finished => snapshot.finished,
             WaitFor::Simulated(seconds) => {
-                if snapshot.time >= since + seconds - 1e-9 {
+                if reached(snapshot.time, since + seconds, snapshot.stats.step_dt) {
                     true
                 } else if stalled && let Some(settled) = snapshot.settled_at {
                     return Err((

@@ -91,9 +91,16 @@ const PUBLISH_INTERVAL: Duration = Duration::from_millis(15);
 /// (the worker then runs flat out and the real-time factor shows the shortfall), s.
 const MAX_LAG: f64 = 0.1;
 
-/// A step ends on a time held for (`Command::HoldAt`) within this share of the step: the
-/// sum of many steps misses it by rounding.
-const HOLD_SLACK: f64 = 1e-6;
+/// A time counts as reached within this share of a step: the sum of many steps misses it
+/// by rounding.
+const STEP_ROUNDING: f64 = 1e-6;
+
+/// Whether simulated time `time` has reached `target` (s) on steps of `dt`: where play stops
+/// at the scene's end and at a hold (`Command::HoldAt`), and where a script's wait for
+/// simulated time ends, so that the wait ends where the hold stopped.
+pub fn reached(time: f64, target: f64, dt: f64) -> bool {
+    time >= target - STEP_ROUNDING * dt
+}
 
 /// Window over which the rates in [`Stats`] are measured.
 const STATS_WINDOW: Duration = Duration::from_secs(1);
@@ -493,7 +500,7 @@ impl WorkerState {
                 self.step_once();
                 // A drape that went on from a sewn garment has the scene's duration from
                 // where it started.
-                let end = self.scene.state.time - self.drape.0.started_at >= self.scene.config.scene.duration - 1e-6 * self.scene.integrator.dt;
+                let end = self.reached(self.drape.0.started_at + self.scene.config.scene.duration);
                 // A settled cloth pauses, as `rosette run` stops: it would only rest at the
                 // cost of a solve per step. Not while the mouse holds it, and only once:
                 // Play after the pause runs on to the scene's end.
@@ -526,9 +533,9 @@ impl WorkerState {
         }
     }
 
-    /// Whether the scene's time has reached `t` (s), to within steps' rounding.
+    /// Whether the scene's time has reached `t` (s) ([`reached`]).
     fn reached(&self, t: f64) -> bool {
-        self.scene.state.time >= t - HOLD_SLACK * self.scene.integrator.dt
+        reached(self.scene.state.time, t, self.scene.integrator.dt)
     }
 
     /// How far simulated time is ahead of wall time since play started, s (negative: behind).
