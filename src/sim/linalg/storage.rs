@@ -193,7 +193,7 @@ impl ScalarCsr {
 
     /// Row `row` of (A ⊗ I₃) x.
     #[inline]
-    pub(super) fn row_product(&self, row: usize, x: &[DVec3]) -> DVec3 {
+    pub(crate) fn row_product(&self, row: usize, x: &[DVec3]) -> DVec3 {
         let (s, e) = (self.row_start[row] as usize, self.row_start[row + 1] as usize);
         self.values[s..e].iter().zip(&self.cols[s..e]).fold(DVec3::ZERO, |acc, (&v, &c)| acc + v * x[c as usize])
     }

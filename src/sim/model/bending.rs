@@ -191,9 +191,9 @@ pub fn curvature_magnitude(k: [f64; 3]) -> f64 {
 /// ½ Σ Q_ab x_a·x_b, J.
 fn quadratic_energy(q: &ScalarCsr, x: &[DVec3]) -> f64 {
     if x.len() < PARALLEL_TRIANGLES {
-        return 0.5 * q.entries().map(|(a, b, v)| v * x[a as usize].dot(x[b as usize])).sum::<f64>();
+        return 0.5 * (0..x.len()).map(|a| x[a].dot(q.row_product(a, x))).sum::<f64>();
     }
-    0.5 * sum_of(x.len(), |a| q.entries_of_row(a as u32).map(|(b, v)| v * x[a].dot(x[b as usize])).sum::<f64>())
+    0.5 * sum_of(x.len(), |a| x[a].dot(q.row_product(a, x)))
 }
 
 /// f −= Q x and the energy ½ xᵀQx = −¼ Σ_ab Q_ab |x_b − x_a|² (Q's rows sum to zero), both
