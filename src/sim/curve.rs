@@ -92,7 +92,8 @@ impl PiecewiseLinear {
     fn segment(&self, x: f64) -> usize {
         // The inner knots at or below x, counted without branches: a measured curve has a
         // handful of knots, and a binary search's mispredicted branches cost more than the
-        // count (the segment search was 4 % of a landing cloth's profile).
+        // count (the segment search was 4 % of a landing cloth's profile; docs/performance-log.md,
+        // "2026-12-07, late").
         let inner = &self.xs[1..self.xs.len() - 1];
         inner.iter().map(|&knot| usize::from(knot <= x)).sum()
     }
