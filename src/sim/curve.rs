@@ -59,11 +59,10 @@ impl PiecewiseLinear {
                 return Err(CurveError::Unsorted { index, x: p[0], previous: points[index - 1][0] });
             }
         }
-        for (index, pair) in points.windows(2).enumerate() {
-            let slope = (pair[1][1] - pair[0][1]) / (pair[1][0] - pair[0][0]);
-            if slope <= 0.0 {
-                return Err(CurveError::NonIncreasing { index, x0: pair[0][0], x1: pair[1][0], slope });
-            }
+        let slopes: Vec<f64> = points.windows(2).map(|pair| (pair[1][1] - pair[0][1]) / (pair[1][0] - pair[0][0])).collect();
+        if let Some(index) = slopes.iter().position(|&slope| slope <= 0.0) {
+            let slope = slopes[index];
+            return Err(CurveError::NonIncreasing { index, x0: points[index][0], x1: points[index + 1][0], slope });
         }
         if !points.iter().any(|p| p[0] == 0.0 && p[1] == 0.0) {
             return Err(CurveError::MissingOrigin);
@@ -79,7 +78,6 @@ impl PiecewiseLinear {
         for i in (0..origin).rev() {
             integral_at_knot[i] = integral_at_knot[i + 1] - 0.5 * (ys[i] + ys[i + 1]) * (xs[i + 1] - xs[i]);
         }
-        let slopes = xs.windows(2).zip(ys.windows(2)).map(|(x, y)| (y[1] - y[0]) / (x[1] - x[0])).collect();
         Ok(Self { xs, ys, integral_at_knot, slopes })
     }
 
@@ -141,12 +139,12 @@ impl PiecewiseLinear {
 
     /// The smallest slope over all segments (bounds how soft the material can become).
     pub fn min_slope(&self) -> f64 {
-        (0..self.xs.len() - 1).map(|i| self.slope_of_segment(i)).fold(f64::INFINITY, f64::min)
+        self.slopes.iter().copied().fold(f64::INFINITY, f64::min)
     }
 
     /// The largest slope over all segments (bounds how stiff the material can become).
     pub fn max_slope(&self) -> f64 {
-        (0..self.xs.len() - 1).map(|i| self.slope_of_segment(i)).fold(0.0, f64::max)
+        self.slopes.iter().copied().fold(0.0, f64::max)
     }
 
     /// The measured points, as given.
