@@ -215,6 +215,18 @@ fn a_strip_sliding_through_a_valley_stays_outside_it() {
 /// acceleration g(sin θ − μ_k cos θ) = 2.41 m/s².
 #[test]
 fn friction_follows_coulombs_law_on_an_incline() {
+    coulomb_on_an_incline(false);
+}
+
+/// The same law with sticking vertices held in place over a step
+/// (`contact.hold_sticking`) instead of held by the stiff smoothed friction: at 10° (tan θ /
+/// μ_s = 0.35, inside the held margin) and 20° it must stay put, at 35° slide as before.
+#[test]
+fn held_friction_follows_coulombs_law_on_an_incline() {
+    coulomb_on_an_incline(true);
+}
+
+fn coulomb_on_an_incline(hold: bool) {
     let run = |angle_deg: f64| {
         let theta = angle_deg.to_radians();
         // The plane's top face passes through the origin, its normal tilted about y.
@@ -239,6 +251,7 @@ fn friction_follows_coulombs_law_on_an_incline() {
             ),
             "scene.duration=0.6",
             "scene.settle_speed=1e-9",
+            &format!("contact.hold_sticking={hold}"),
         ]);
         let mut scene = build("tablecloth", &overrides);
         // Lay the flat cloth on the incline at the contact thickness.
@@ -258,13 +271,16 @@ fn friction_follows_coulombs_law_on_an_incline() {
         samples
     };
     let g = rosette::physics::STANDARD_GRAVITY;
-    let still = run(20.0);
-    let (_, speed) = *still.last().unwrap();
-    // Sliding would reach 1.3 m/s by now. Friction smoothed below the slip speed v_ε and
-    // measured from each step's start would let it creep on at v_ε·tan θ/μ_s = 0.73 mm/s
-    // (F/(μ_s N) = tan θ/μ_s): measured from where it stuck, static friction holds it.
-    let creep = 1e-3 * 20f64.to_radians().tan() / 0.5;
-    assert!(speed.abs() < 0.05 * creep, "at 20° the cloth slides at {speed} m/s (smoothed friction's creep: {creep} m/s)");
+    let angles: &[f64] = if hold { &[10.0, 20.0] } else { &[20.0] };
+    for &angle in angles {
+        let still = run(angle);
+        let (_, speed) = *still.last().unwrap();
+        // Without friction it would slide at 1–2 m/s by now. Friction smoothed below the slip speed v_ε
+        // and measured from each step's start would let it creep on at v_ε·tan θ/μ_s
+        // (F/(μ_s N) = tan θ/μ_s): measured from where it stuck, static friction holds it.
+        let creep = 1e-3 * angle.to_radians().tan() / 0.5;
+        assert!(speed.abs() < 0.05 * creep, "at {angle}° the cloth slides at {speed} m/s (smoothed friction's creep: {creep} m/s)");
+    }
     let sliding = run(35.0);
     let theta = 35f64.to_radians();
     let expected = g * (theta.sin() - 0.4 * theta.cos());

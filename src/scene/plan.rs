@@ -218,11 +218,12 @@ impl RunPlan {
                 let factor = c.contact.stiffness / scene.contact.stiffness;
                 let _ = writeln!(
                     text,
-                    "  contact: stiffness {} m/dt²{}, pair list kept by {} motion, friction sticks below {:.2} mm/s",
+                    "  contact: stiffness {} m/dt²{}, pair list kept by {} motion, friction sticks below {:.2} mm/s{}",
                     c.contact.stiffness,
                     if factor != 1.0 { format!(" (the scene's × {factor:.3})") } else { String::new() },
                     if c.contact.relative_motion { "relative" } else { "absolute" },
                     1e3 * c.contact.slip_speed,
+                    if c.contact.hold_sticking { ", sticking vertices held over a step" } else { "" },
                 );
             }
         }

@@ -117,7 +117,18 @@ pub struct ContactSettings {
     /// count a falling or settling cloth's common drift, which otherwise lists every
     /// in-plane neighbour as a pair and caps Newton's steps by it (the fast path).
     pub relative_motion: bool,
+    /// Hold a vertex that sticks to a prop where it is over the next step (its position
+    /// prescribed, as a pinned vertex's), instead of solving its sticking friction as a
+    /// stiff spring; released where the force holding it leaves `HOLD_MARGIN` of Coulomb's
+    /// cone. Off by default: it trades the settled drape for speed (docs/fast-path.md,
+    /// "What was tried and not kept").
+    pub hold_sticking: bool,
 }
+
+/// The share of Coulomb's cone within which a vertex is held (`ContactSettings::hold_sticking`):
+/// a held vertex is rigid, so load its sliding neighbours would share gathers on it; held
+/// only well inside the cone, the vertices near slipping keep the smoothed friction.
+pub const HOLD_MARGIN: f64 = 0.5;
 
 impl Default for ContactSettings {
     fn default() -> Self {
@@ -130,6 +141,7 @@ impl Default for ContactSettings {
             stiffness: 100.0,
             slip_speed: 1e-3,
             relative_motion: false,
+            hold_sticking: false,
         }
     }
 }

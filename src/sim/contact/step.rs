@@ -44,6 +44,17 @@ impl StepContacts {
         }
     }
 
+    /// The vertices that end the step at `y` sticking to a prop with their friction force
+    /// within `margin` of μ_s times the normal force (their slip within `margin` of the
+    /// slip threshold), with that prop's normal.
+    pub fn sticking(&self, y: &[DVec3], margin: f64) -> Vec<(u32, DVec3)> {
+        self.planes
+            .iter()
+            .filter(|c| c.normal_force > 0.0 && c.slip(y[c.vertex as usize]).length() <= margin * self.slip)
+            .map(|c| (c.vertex, c.normal))
+            .collect()
+    }
+
     /// Friction dissipation function F(s) and F'(s) of the tangential slip s over the step.
     fn friction(&self, s: f64) -> (f64, f64) {
         let (e, ms, mk) = (self.slip, self.mu_static, self.mu_kinetic);

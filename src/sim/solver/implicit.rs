@@ -3,8 +3,10 @@
 
 use super::report::{Stopwatch, StepReport};
 use super::{Integrator, State};
+use crate::sim::contact::HOLD_MARGIN;
 use crate::sim::model::Model;
 use glam::DVec3;
+use std::borrow::Cow;
 
 impl Integrator {
     /// One implicit Euler (or, with `bdf2` and a history, BDF2) step of `s`, in place.
@@ -25,11 +27,16 @@ impl Integrator {
         };
         let t_next = s.time + dt;
         let start_velocity = s.v.clone();
-        let step = ImplicitStep { model, h, dt, anchor: &anchor, inertial: &inertial, velocity: &start_velocity };
+        let holding = model.contact.as_ref().is_some_and(|c| c.settings.hold_sticking) && self.newton.minimizer == super::Minimizer::Newton;
+        let fixed = step_fixed(model, &mut s.held, holding);
+        let fixed = &*fixed;
+        let step = ImplicitStep { model, h, dt, anchor: &anchor, inertial: &inertial, velocity: &start_velocity, fixed };
         let prescribe = |mut y: Vec<DVec3>| {
             for (i, yi) in y.iter_mut().enumerate() {
                 if model.fixed[i] {
                     *yi = model.prescribed_position(i, t_next);
+                } else if fixed[i] {
+                    *yi = s.x[i];
                 }
             }
             y
@@ -52,16 +59,17 @@ impl Integrator {
                 // The prediction includes gravity's pull over the step, so that contacts a
                 // falling cloth is about to make are there from the first iteration.
                 let predicted: Vec<DVec3> = (0..n).map(|i| inertial[i] + h * h * model.options.gravity).collect();
-                let mut contacts = contact.begin_step(model.cloth(), &mut self.near_pairs, &s.x, &s.stuck, &predicted, h);
+                let cloth = crate::sim::contact::Cloth { fixed, ..model.cloth() };
+                let mut contacts = contact.begin_step(cloth, &mut self.near_pairs, &s.x, &s.stuck, &predicted, h);
                 // Newton's path must start where the cloth is: jumping straight to the
                 // inertial guess could carry a vertex through a layer before any contact
                 // force acts. Start from x_n moved towards the guess as far as no cloth–cloth
                 // pair can meet.
                 if contacts.pair_count() > 0 {
-                    let guess: Vec<DVec3> = (0..n).map(|i| if model.fixed[i] { DVec3::ZERO } else { y[i] - s.x[i] }).collect();
+                    let guess: Vec<DVec3> = (0..n).map(|i| if fixed[i] { DVec3::ZERO } else { y[i] - s.x[i] }).collect();
                     let alpha = contacts.max_step(&s.x, &guess);
                     for i in 0..n {
-                        if !model.fixed[i] {
+                        if !fixed[i] {
                             y[i] = s.x[i] + alpha * guess[i];
                         }
                     }
@@ -72,12 +80,12 @@ impl Integrator {
                 for pass in 0..4 {
                     self.minimize(&step, Some(&contacts), &mut y, &mut report);
                     watch.restart();
-                    let mut changed = contact.add_missed(&mut contacts, model.cloth(), &s.x, &s.stuck, &y, h);
+                    let mut changed = contact.add_missed(&mut contacts, cloth, &s.x, &s.stuck, &y, h);
                     if pass < 2 {
                         // Planes are renewed twice at most: a vertex still inside after
                         // that is left to the penetration measure, not to the step's
                         // convergence.
-                        changed += contact.refresh_planes(&mut contacts, model.cloth(), &y);
+                        changed += contact.refresh_planes(&mut contacts, cloth, &y);
                     }
                     watch.contact();
                     if changed == 0 {
@@ -88,8 +96,12 @@ impl Integrator {
                         report.newton_unconverged = true;
                     }
                 }
-                report.timings += watch.timings;
                 contacts.stuck_after(&y, &mut s.stuck);
+                if holding {
+                    self.hold_sticking(&step, &contacts, &y, &mut s.held);
+                    watch.contact();
+                }
+                report.timings += watch.timings;
                 step_contacts = Some(contacts);
             }
         }
@@ -120,7 +132,52 @@ impl Integrator {
     }
 }
 
+/// The step's prescribed vertices: the model's, and those `held` where they stick to a prop
+/// (all released where the scene does not hold them).
+fn step_fixed<'a>(model: &'a Model, held: &mut Vec<Option<DVec3>>, holding: bool) -> Cow<'a, [bool]> {
+    held.resize(model.fixed.len(), None);
+    if !holding {
+        held.fill(None);
+    }
+    if held.iter().any(Option::is_some) {
+        Cow::Owned(model.fixed.iter().zip(held.iter()).map(|(&f, h)| f || h.is_some()).collect())
+    } else {
+        Cow::Borrowed(&model.fixed)
+    }
+}
+
 impl Integrator {
+    /// Which vertices the next step holds (`ContactSettings::hold_sticking`), into `held`:
+    /// one held over this step stays held while the force holding it, −∂Φ/∂y without
+    /// contact, pushes it against the prop's surface and lies within `HOLD_MARGIN` of
+    /// Coulomb's cone about it (|f_t| ≤ margin·μ_s·f_n); one not held is held from the next
+    /// step where it ends this one sticking with its friction within that margin.
+    fn hold_sticking(&mut self, step: &ImplicitStep, contacts: &crate::sim::contact::StepContacts, y: &[DVec3], held: &mut Vec<Option<DVec3>>) {
+        let ImplicitStep { model, h, anchor, inertial, .. } = *step;
+        let Some(contact) = &model.contact else { return };
+        let mu = contact.settings.friction_static;
+        let zeta = model.options.damping;
+        let n = y.len();
+        let mut next = vec![None; n];
+        if held.iter().any(Option::is_some) {
+            self.forces.resize(n, DVec3::ZERO);
+            model.forces(y, &mut self.forces);
+            for i in 0..n {
+                let Some(normal) = held[i] else { continue };
+                let m = model.mass[i];
+                let holding = m / (h * h) * (y[i] - inertial[i]) + zeta * m / h * (y[i] - anchor[i]) - self.forces[i];
+                let push = holding.dot(normal);
+                if push > 0.0 && (holding - push * normal).length() <= HOLD_MARGIN * mu * push {
+                    next[i] = Some(normal);
+                }
+            }
+        }
+        for (v, normal) in contacts.sticking(y, HOLD_MARGIN) {
+            next[v as usize] = Some(normal);
+        }
+        *held = next;
+    }
+
     /// Minimises Φ from `y` with the step's method: Newton, or the quasi-Newton step with
     /// Newton finishing what it has not converged (its linear convergence is slow where
     /// the tolerance is tight, as when the cloth comes to rest; Newton's is quadratic from
@@ -149,15 +206,17 @@ pub(super) struct ImplicitStep<'a> {
     pub inertial: &'a [DVec3],
     /// Velocities at the start of the step, m/s.
     pub velocity: &'a [DVec3],
+    /// The step's prescribed vertices: the model's fixed ones and those held where they
+    /// stick to a prop (`ContactSettings::hold_sticking`).
+    pub fixed: &'a [bool],
 }
 
 impl ImplicitStep<'_> {
     /// Implicit Euler's local error estimate ½Δt·max|v_{n+1} − v_n| of the step were it to
     /// end at `y` (v_{n+1} = (y − x̂)/h), m; over the free vertices.
     pub fn local_error(&self, y: &[DVec3]) -> f64 {
-        let model = self.model;
         (0..y.len())
-            .filter(|&i| !model.fixed[i])
+            .filter(|&i| !self.fixed[i])
             .map(|i| 0.5 * self.dt * ((y[i] - self.anchor[i]) / self.h - self.velocity[i]).length())
             .fold(0.0, f64::max)
     }
@@ -167,7 +226,7 @@ impl ImplicitStep<'_> {
         let (model, h) = (self.model, self.h);
         let zeta = model.options.damping;
         let inertia: f64 = (0..y.len())
-            .filter(|&i| !model.fixed[i])
+            .filter(|&i| !self.fixed[i])
             .map(|i| {
                 let m = model.mass[i];
                 m / (2.0 * h * h) * (y[i] - self.inertial[i]).length_squared()

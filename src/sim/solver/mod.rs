@@ -51,12 +51,15 @@ pub struct State {
     /// Where each vertex resting on a prop sticks from, by vertex (`StepContacts::stuck_after`):
     /// part of the state, so that a rejected step leaves it as it was.
     pub(super) stuck: Vec<Option<DVec3>>,
+    /// The vertices held where they are over the next step because they stick to a prop
+    /// (`ContactSettings::hold_sticking`), by vertex: the prop's outward normal there.
+    pub(super) held: Vec<Option<DVec3>>,
 }
 
 impl State {
     pub fn at_rest(x: Vec<DVec3>) -> Self {
         let v = vec![DVec3::ZERO; x.len()];
-        Self { x, v, time: 0.0, steps: 0, previous: None, stuck: Vec::new() }
+        Self { x, v, time: 0.0, steps: 0, previous: None, stuck: Vec::new(), held: Vec::new() }
     }
 
     /// Forgets the previous step (BDF2's history), as a change of time step requires.

@@ -63,8 +63,8 @@ impl<'a> NewtonProblem<'a> {
         // Compressed edges may take back up to this share of each vertex's inertia in
         // Newton's matrix: it stays positive definite, and Newton converges quadratically
         // where the cloth buckles unless the compression outweighs inertia.
-        let softening = mass_diagonal.iter().zip(&model.fixed).map(|(&d, &f)| if f { f64::INFINITY } else { SOFTENING_SHARE * d }).collect();
-        let all_free = !model.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
+        let softening = mass_diagonal.iter().zip(step.fixed).map(|(&d, &f)| if f { f64::INFINITY } else { SOFTENING_SHARE * d }).collect();
+        let all_free = !step.fixed.iter().any(|&f| f) && contacts.is_none_or(|c| c.is_empty());
         let base_tolerance = tolerance * model.mean_edge_length;
         Self { step, contacts, mass_diagonal, softening, tolerance: base_tolerance, base_tolerance, error_share, error_cap, all_free, judge_contraction }
     }
@@ -197,14 +197,14 @@ impl Integrator {
 
     /// ∇Φ at `y` into `gradient` (zero on fixed vertices), and its norm.
     pub(super) fn gradient(&mut self, problem: &NewtonProblem, y: &[DVec3], gradient: &mut [DVec3], watch: &mut Stopwatch) -> f64 {
-        let ImplicitStep { model, h, anchor, inertial, .. } = *problem.step;
+        let ImplicitStep { model, h, anchor, inertial, fixed, .. } = *problem.step;
         let zeta = model.options.damping;
         let n = y.len();
         self.forces.resize(n, DVec3::ZERO);
         model.forces(y, &mut self.forces);
         let forces = &self.forces;
         for i in 0..n {
-            gradient[i] = if model.fixed[i] {
+            gradient[i] = if fixed[i] {
                 DVec3::ZERO
             } else {
                 model.mass[i] / (h * h) * (y[i] - inertial[i]) + zeta * model.mass[i] / h * (y[i] - anchor[i]) - forces[i]
@@ -212,8 +212,8 @@ impl Integrator {
         }
         watch.forces();
         if let Some(c) = problem.contacts {
-            c.add_gradient(y, gradient, &model.fixed);
-            for (g, &f) in gradient.iter_mut().zip(&model.fixed) {
+            c.add_gradient(y, gradient, fixed);
+            for (g, &f) in gradient.iter_mut().zip(fixed) {
                 if f {
                     *g = DVec3::ZERO;
                 }
@@ -235,7 +235,7 @@ impl Integrator {
         let (Some(before), Some(full), Some(cached)) = (history.previous_norm, history.previous_full_step, self.preconditioner.as_ref()) else {
             return None;
         };
-        if !(cached.fits(&problem.step.model.fixed) && norm < 0.5 * before && full * norm / before < problem.tolerance) {
+        if !(cached.fits(problem.step.fixed) && norm < 0.5 * before && full * norm / before < problem.tolerance) {
             return None;
         }
         cached.preconditioner.apply(&work.rhs, &mut work.direction);
@@ -245,7 +245,7 @@ impl Integrator {
         let length = work.direction.iter().map(|d| d.length()).fold(0.0, f64::max);
         watch.solve();
         if length < problem.tolerance && problem.contacts.is_none_or(|c| c.step_limit(y, &work.direction) >= 1.0) {
-            let fixed = &problem.step.model.fixed;
+            let fixed = problem.step.fixed;
             for (i, d) in work.direction.iter().enumerate() {
                 if !fixed[i] {
                     y[i] += *d;
@@ -312,8 +312,7 @@ impl Integrator {
             problem.assemble(y, &mut work.stiffness, CompressedEdges::Exact);
             watch.forces();
         }
-        let model = problem.step.model;
-        let system = SystemMatrix { mass_diagonal: &problem.mass_diagonal, stiffness: &work.stiffness, bending, fixed: &model.fixed, couplings: &work.couplings };
+        let system = SystemMatrix { mass_diagonal: &problem.mass_diagonal, stiffness: &work.stiffness, bending, fixed: problem.step.fixed, couplings: &work.couplings };
         if global {
             self.solve_global(problem, &system, &mut work.bounded, y, &work.rhs, &mut work.direction, cg_tolerance, bounded_throughout, report, watch);
             *bounded_throughout
@@ -335,7 +334,7 @@ fn line_search(problem: &NewtonProblem, work: &mut NewtonWork, history: &mut New
         // Not a descent direction (the CG broke down): fall back to steepest descent
         // scaled by the mass term.
         for i in 0..n {
-            direction[i] = if model.fixed[i] { DVec3::ZERO } else { -gradient[i] / problem.mass_diagonal[i] };
+            direction[i] = if problem.step.fixed[i] { DVec3::ZERO } else { -gradient[i] / problem.mass_diagonal[i] };
         }
     }
     let slope: f64 = gradient.iter().zip(direction.iter()).map(|(g, d)| g.dot(*d)).sum();

@@ -124,7 +124,7 @@ impl Integrator {
             for (v, b) in constant.values.iter_mut().zip(&bending.values) {
                 *v += b;
             }
-            let Some(pattern) = ScalarPattern::new(&constant, &model.fixed) else { return false };
+            let Some(pattern) = ScalarPattern::new(&constant, problem.step.fixed) else { return false };
             self.quasi = Some(StepMatrices { constant, pattern, factor: None, vertices: n });
         }
         let quasi = self.quasi.as_mut().expect("made above");
@@ -332,7 +332,7 @@ impl Integrator {
         self.forces.resize(y.len(), DVec3::ZERO);
         let mut phi = model.energy_and_forces(y, &mut self.forces);
         for i in 0..y.len() {
-            gradient[i] = if model.fixed[i] {
+            gradient[i] = if problem.step.fixed[i] {
                 DVec3::ZERO
             } else {
                 let m = model.mass[i];
@@ -343,8 +343,8 @@ impl Integrator {
         }
         watch.forces();
         if let Some(c) = problem.contacts {
-            phi += c.energy_and_gradient(y, gradient, &model.fixed);
-            for (g, &f) in gradient.iter_mut().zip(&model.fixed) {
+            phi += c.energy_and_gradient(y, gradient, problem.step.fixed);
+            for (g, &f) in gradient.iter_mut().zip(problem.step.fixed) {
                 if f {
                     *g = DVec3::ZERO;
                 }
