@@ -7,6 +7,7 @@ pub mod material;
 pub mod mesh;
 pub mod model;
 pub mod solver;
+pub(crate) mod team;
 
 /// Revision of the model's physics: raised by every change that alters simulated results,
 /// so that results cached from an older model (the chart's drape reference) are recomputed.

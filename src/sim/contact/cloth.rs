@@ -2,7 +2,7 @@
 //! the pairs kept apart in each step's solve, and the continuous-collision fail-safe.
 
 use super::geometry::{SpatialHash, closest_point_triangle, closest_points_segments, edge_edge_ccd, segment_crosses_triangle, vertex_triangle_ccd};
-use super::{Cloth, ContactModel, PARALLEL_TRIANGLES, SelfPair, boxes_overlap, closing_bound, filter_in_order};
+use super::{Cloth, ContactModel, PARALLEL_TRIANGLES, SelfPair, TEAM_ITEMS, boxes_overlap, closing_bound, filter_in_order};
 use glam::DVec3;
 use std::borrow::Cow;
 
@@ -346,35 +346,30 @@ impl ContactModel {
 
 /// Runs `search(i, marks, found)` for every i < `count` and returns what it found, in the
 /// order of i whatever the number of threads (if `parallel`, fixed chunks on rayon's
-/// threads). `marks` holds `marks_len` entries, u32::MAX at first, for the search
+/// threads; else, from [`TEAM_ITEMS`] items, two halves, one on the team's). `marks` holds `marks_len` entries, u32::MAX at first, for the search
 /// to mark what item i has taken with i: each thread keeps one array for its chunks, which
 /// is sound because no two items share a number.
 fn search_in_chunks<T: Send>(count: usize, marks_len: usize, parallel: bool, search: impl Fn(usize, &mut [u32], &mut Vec<T>) + Sync) -> Vec<T> {
     use rayon::prelude::*;
     const CHUNK: usize = 1024;
-    let run = |first: usize, marks: &mut [u32], found: &mut Vec<T>| {
-        let end = if parallel { (first + CHUNK).min(count) } else { count };
-        for i in first..end {
-            search(i, marks, found);
+    let run = |range: std::ops::Range<usize>, marks: &mut [u32]| {
+        let mut found = Vec::new();
+        for i in range {
+            search(i, marks, &mut found);
         }
+        found
     };
-    if !parallel {
-        let (mut marks, mut found) = (vec![u32::MAX; marks_len], Vec::new());
-        run(0, &mut marks, &mut found);
-        return found;
+    let fresh = || vec![u32::MAX; marks_len];
+    if parallel {
+        let parts: Vec<Vec<T>> = (0..count.div_ceil(CHUNK)).into_par_iter().map_init(fresh, |marks, c| run(c * CHUNK..((c + 1) * CHUNK).min(count), marks)).collect();
+        parts.into_iter().flatten().collect()
+    } else if count >= TEAM_ITEMS {
+        let (mut low, high) = crate::sim::team::join(|| run(0..count / 2, &mut fresh()), || run(count / 2..count, &mut fresh()));
+        low.extend(high);
+        low
+    } else {
+        run(0..count, &mut fresh())
     }
-    let parts: Vec<Vec<T>> = (0..count.div_ceil(CHUNK))
-        .into_par_iter()
-        .map_init(
-            || vec![u32::MAX; marks_len],
-            |marks, c| {
-                let mut found = Vec::new();
-                run(c * CHUNK, marks, &mut found);
-                found
-            },
-        )
-        .collect();
-    parts.into_iter().flatten().collect()
 }
 
 fn mean_edge(x: &[DVec3], triangles: &[[u32; 3]]) -> f64 {

@@ -527,37 +527,41 @@ impl ContactModel {
 /// the threads would make it slower.
 const PARALLEL_TRIANGLES: usize = 4096;
 
+/// Below [`PARALLEL_TRIANGLES`], searches over at least this many items are split in two
+/// halves, one on the team's thread ([`crate::sim::team`]), whose hand-off costs far less
+/// than rayon's.
+const TEAM_ITEMS: usize = 1024;
+
 /// What `keep(i, &items[i])` returns, in the order of i (if `parallel`, fixed chunks on
-/// rayon's threads). Both paths run the same loop over a chunk, which `keep` is inlined
-/// into: with an iterator adapter on each path it is not, and the filters, run on every
-/// pair every step, are slower. The chunks are small enough for the threads to share the
+/// rayon's threads; else, from [`TEAM_ITEMS`] items, two halves, one on the team's). Every
+/// path runs the same loop over a range, which `keep` is inlined into: with an iterator
+/// adapter on each path it is not, and the filters, run on every pair every step, are
+/// slower. The chunks are small enough for the threads to share the
 /// items evenly (in chunks of 4 096 a 10k garment's 5 247 vertices went 4 096 to one
 /// thread and 1 151 to the other); what is kept, and its order, do not depend on them.
 fn filter_in_order<T: Sync, U: Send>(items: &[T], parallel: bool, keep: impl Fn(usize, &T) -> Option<U> + Sync) -> Vec<U> {
     use rayon::prelude::*;
     const CHUNK: usize = 1024;
-    let filter = |first: usize, out: &mut Vec<U>| {
-        let end = if parallel { (first + CHUNK).min(items.len()) } else { items.len() };
-        for (i, item) in items[first..end].iter().enumerate() {
-            if let Some(u) = keep(first + i, item) {
+    let filter = |range: std::ops::Range<usize>| {
+        let mut out = Vec::new();
+        for (i, item) in items[range.clone()].iter().enumerate() {
+            if let Some(u) = keep(range.start + i, item) {
                 out.push(u);
             }
         }
+        out
     };
-    let mut found = Vec::new();
-    if !parallel {
-        filter(0, &mut found);
-        return found;
+    let n = items.len();
+    if parallel {
+        let parts: Vec<Vec<U>> = (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| filter(c * CHUNK..((c + 1) * CHUNK).min(n))).collect();
+        parts.into_iter().flatten().collect()
+    } else if n >= TEAM_ITEMS {
+        let (mut low, high) = crate::sim::team::join(|| filter(0..n / 2), || filter(n / 2..n));
+        low.extend(high);
+        low
+    } else {
+        filter(0..n)
     }
-    let parts: Vec<Vec<U>> = (0..items.len().div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|c| {
-            let mut out = Vec::new();
-            filter(c * CHUNK, &mut out);
-            out
-        })
-        .collect();
-    parts.into_iter().flatten().collect()
 }
 
 /// How far a pair's gap can close when its four vertices move by `d` (vertex then triangle

@@ -1,7 +1,7 @@
 //! The preconditioned conjugate gradient.
 
 use super::preconditioner::Preconditioner;
-use super::storage::PARALLEL_ROWS;
+use super::storage::{PARALLEL_ROWS, TEAM_ROWS};
 use super::system::SystemMatrix;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -211,15 +211,23 @@ const LEAST_PIVOT: f64 = 1e-4;
 /// share a 10k garment's rows evenly.
 const CHUNK: usize = 256;
 
-/// `f(rows)` for the chunks of [`CHUNK`] rows of `0..n`, over rayon's pool when `n` is long,
-/// the results in chunk order: partial sums added in that order are the same on any number
-/// of threads.
+/// `f(rows)` for the chunks of [`CHUNK`] rows of `0..n`, the results in chunk order: partial
+/// sums added in that order are the same on any number of threads. The chunks go in two
+/// halves to the team ([`crate::sim::team`]) from [`TEAM_ROWS`] rows, over rayon's pool from
+/// [`PARALLEL_ROWS`].
 fn in_order<T: Send>(n: usize, f: impl Fn(Range<usize>) -> T + Sync) -> Vec<T> {
     let rows = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(n);
-    if n < PARALLEL_ROWS {
-        (0..n.div_ceil(CHUNK)).map(|c| f(rows(c))).collect()
+    let chunks = n.div_ceil(CHUNK);
+    if n < TEAM_ROWS {
+        (0..chunks).map(|c| f(rows(c))).collect()
+    } else if n < PARALLEL_ROWS {
+        let mid = chunks.div_ceil(2);
+        let run = |range: Range<usize>| range.map(|c| f(rows(c))).collect::<Vec<T>>();
+        let (mut low, high) = crate::sim::team::join(|| run(0..mid), || run(mid..chunks));
+        low.extend(high);
+        low
     } else {
-        (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| f(rows(c))).collect()
+        (0..chunks).into_par_iter().map(|c| f(rows(c))).collect()
     }
 }
 
@@ -228,14 +236,25 @@ fn in_order<T: Send>(n: usize, f: impl Fn(Range<usize>) -> T + Sync) -> Vec<T> {
 fn in_order_mut<T: Send>(a: &mut [DVec3], b: &mut [DVec3], f: impl Fn(Range<usize>, &mut [DVec3], &mut [DVec3]) -> T + Sync) -> Vec<T> {
     let n = a.len();
     let rows = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(n);
-    if b.is_empty() {
-        if n < PARALLEL_ROWS {
-            a.chunks_mut(CHUNK).enumerate().map(|(c, a)| f(rows(c), a, &mut [])).collect()
+    // The chunks from `first` of the slices given, which start at chunk `first`.
+    let serial = |first: usize, a: &mut [DVec3], b: &mut [DVec3]| -> Vec<T> {
+        if b.is_empty() {
+            a.chunks_mut(CHUNK).enumerate().map(|(c, a)| f(rows(first + c), a, &mut [])).collect()
         } else {
-            a.par_chunks_mut(CHUNK).enumerate().map(|(c, a)| f(rows(c), a, &mut [])).collect()
+            a.chunks_mut(CHUNK).zip(b.chunks_mut(CHUNK)).enumerate().map(|(c, (a, b))| f(rows(first + c), a, b)).collect()
         }
+    };
+    if n < TEAM_ROWS {
+        serial(0, a, b)
     } else if n < PARALLEL_ROWS {
-        a.chunks_mut(CHUNK).zip(b.chunks_mut(CHUNK)).enumerate().map(|(c, (a, b))| f(rows(c), a, b)).collect()
+        let mid = n.div_ceil(CHUNK).div_ceil(2);
+        let (a_low, a_high) = a.split_at_mut(mid * CHUNK);
+        let (b_low, b_high) = if b.is_empty() { (&mut [][..], &mut [][..]) } else { b.split_at_mut(mid * CHUNK) };
+        let (mut low, high) = crate::sim::team::join(|| serial(0, a_low, b_low), || serial(mid, a_high, b_high));
+        low.extend(high);
+        low
+    } else if b.is_empty() {
+        a.par_chunks_mut(CHUNK).enumerate().map(|(c, a)| f(rows(c), a, &mut [])).collect()
     } else {
         a.par_chunks_mut(CHUNK).zip(b.par_chunks_mut(CHUNK)).enumerate().map(|(c, (a, b))| f(rows(c), a, b)).collect()
     }

@@ -52,18 +52,25 @@ pub(super) const PARALLEL_ROWS: usize = 4096;
 /// 2 175 to the other).
 const CHUNK: usize = 256;
 
-/// Calls `f(row, &mut y[row])` for every row, in chunks of [`CHUNK`] rows over rayon's pool
-/// when `y` is long. Each row is computed alone, so the result does not depend on the chunks.
+/// From this many rows up to [`PARALLEL_ROWS`] a pass is split in two halves, one on the
+/// calling thread and one on the team's ([`crate::sim::team`]), whose hand-off costs far
+/// less than rayon's.
+pub(super) const TEAM_ROWS: usize = 1024;
+
+/// Calls `f(row, &mut y[row])` for every row: in two halves on the team from [`TEAM_ROWS`]
+/// rows, in chunks of [`CHUNK`] rows over rayon's pool from [`PARALLEL_ROWS`]. Each row is
+/// computed alone, so the result does not depend on the split.
 pub(super) fn for_rows(y: &mut [DVec3], f: impl Fn(usize, &mut DVec3) + Sync) {
     use rayon::prelude::*;
-    if y.len() < PARALLEL_ROWS {
-        y.iter_mut().enumerate().for_each(|(row, out)| f(row, out));
+    let serial = |first: usize, y: &mut [DVec3]| y.iter_mut().enumerate().for_each(|(row, out)| f(first + row, out));
+    if y.len() < TEAM_ROWS {
+        serial(0, y);
+    } else if y.len() < PARALLEL_ROWS {
+        let mid = y.len() / 2;
+        let (low, high) = y.split_at_mut(mid);
+        crate::sim::team::join(|| serial(0, low), || serial(mid, high));
     } else {
-        y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, chunk)| {
-            for (i, out) in chunk.iter_mut().enumerate() {
-                f(c * CHUNK + i, out);
-            }
-        });
+        y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, chunk)| serial(c * CHUNK, chunk));
     }
 }
 
@@ -71,14 +78,16 @@ pub(super) fn for_rows(y: &mut [DVec3], f: impl Fn(usize, &mut DVec3) + Sync) {
 /// the `j`-th): calls `f(row, &mut y[row * k..row * k + k])` for every row.
 pub(super) fn for_row_groups(y: &mut [DVec3], k: usize, f: impl Fn(usize, &mut [DVec3]) + Sync) {
     use rayon::prelude::*;
-    if y.len() < PARALLEL_ROWS * k {
-        y.chunks_mut(k).enumerate().for_each(|(row, out)| f(row, out));
+    let rows = y.len() / k;
+    let serial = |first: usize, y: &mut [DVec3]| y.chunks_mut(k).enumerate().for_each(|(row, out)| f(first + row, out));
+    if rows < TEAM_ROWS {
+        serial(0, y);
+    } else if rows < PARALLEL_ROWS {
+        let mid = rows / 2;
+        let (low, high) = y.split_at_mut(mid * k);
+        crate::sim::team::join(|| serial(0, low), || serial(mid, high));
     } else {
-        y.par_chunks_mut(CHUNK * k).enumerate().for_each(|(c, chunk)| {
-            for (i, out) in chunk.chunks_mut(k).enumerate() {
-                f(c * CHUNK + i, out);
-            }
-        });
+        y.par_chunks_mut(CHUNK * k).enumerate().for_each(|(c, chunk)| serial(c * CHUNK, chunk));
     }
 }
 

@@ -352,34 +352,36 @@ fn deflated_cg_solves_the_system_and_fewer_iterations_with_nearby_solutions() {
     assert!(residual(&x_other, &b) < 2e-8);
 }
 
-/// Long enough for the solve's passes to run in parallel chunks, deflated CG still solves the
-/// system (the residual checked by the product), and gives the same iterate, bit for bit, on
-/// one thread and on two: the partial sums are added in the chunks' order.
+/// Long enough for the solve's passes to run in two halves on the team (2 000 rows) or in
+/// parallel chunks on rayon's pool (8 232), deflated CG still solves the system (the
+/// residual checked by the product), and gives the same iterate, bit for bit, on one thread
+/// and on two: the partial sums are added in the chunks' order.
 #[test]
 fn deflated_cg_in_parallel_chunks_solves_the_system_the_same_on_any_thread_count() {
-    let n = 2 * 4096 + 40;
-    let (k, q, mass, fixed, couplings) = coupled_chain(n);
-    let a = SystemMatrix { mass_diagonal: &mass, stiffness: &k, bending: Some(&q), fixed: &fixed, couplings: &couplings };
-    let jacobi = Preconditioner::BlockJacobi(a.block_jacobi());
-    let mut recycled = Recycled::default();
-    for phase in [0.0, 0.05, 0.1, 0.15, 0.2, 0.25] {
-        let mut x = vec![DVec3::ZERO; n];
-        pcg_deflated(&a, &jacobi, &wave(n, phase), &mut x, 1e-8, 5000, None);
-        recycled.remember(&x, 8);
-    }
-    let b = wave(n, 0.3);
-    let solve_on = |threads: usize, deflation: Option<&Recycled>| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| solved(&a, &jacobi, &b, deflation))
-    };
-    let (plain, plain_iterations) = solve_on(2, None);
-    let (one, deflated_iterations) = solve_on(1, Some(&recycled));
-    let (two, _) = solve_on(2, Some(&recycled));
-    assert_eq!(one, two, "one thread and two");
-    assert!(deflated_iterations < plain_iterations, "deflated {deflated_iterations} against plain {plain_iterations} iterations");
-    for x in [&plain, &two] {
-        let residual = relative_residual(&a, x, &b);
-        assert!(residual < 2e-8, "{residual}");
+    for n in [2_000, 2 * 4096 + 40] {
+        let (k, q, mass, fixed, couplings) = coupled_chain(n);
+        let a = SystemMatrix { mass_diagonal: &mass, stiffness: &k, bending: Some(&q), fixed: &fixed, couplings: &couplings };
+        let jacobi = Preconditioner::BlockJacobi(a.block_jacobi());
+        let mut recycled = Recycled::default();
+        for phase in [0.0, 0.05, 0.1, 0.15, 0.2, 0.25] {
+            let mut x = vec![DVec3::ZERO; n];
+            pcg_deflated(&a, &jacobi, &wave(n, phase), &mut x, 1e-8, 5000, None);
+            recycled.remember(&x, 8);
+        }
+        let b = wave(n, 0.3);
+        let solve_on = |threads: usize, deflation: Option<&Recycled>| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| solved(&a, &jacobi, &b, deflation))
+        };
+        let (plain, plain_iterations) = solve_on(2, None);
+        let (one, deflated_iterations) = solve_on(1, Some(&recycled));
+        let (two, _) = solve_on(2, Some(&recycled));
+        assert_eq!(one, two, "{n} rows: one thread and two");
+        assert!(deflated_iterations < plain_iterations, "{n} rows: deflated {deflated_iterations} against plain {plain_iterations} iterations");
+        for x in [&plain, &two] {
+            let residual = relative_residual(&a, x, &b);
+            assert!(residual < 2e-8, "{n} rows: {residual}");
+        }
     }
 }
 

@@ -3,7 +3,7 @@
 //! bending by a measured moment–curvature curve.
 
 use super::charts::{PanelCharts, Placement};
-use super::{Model, ModelError, PARALLEL_TRIANGLES, sorted_edge, sum_of, to_warp_frame};
+use super::{Model, ModelError, PARALLEL_TRIANGLES, TEAM_TRIANGLES, sorted_edge, sum_of, to_warp_frame};
 use crate::sim::curve::PiecewiseLinear;
 use crate::sim::linalg::ScalarCsr;
 use crate::sim::material::BendingStiffness;
@@ -224,8 +224,12 @@ fn subtract_quadratic_force(q: &ScalarCsr, x: &[DVec3], f: &mut [DVec3]) {
         let xa = x[a];
         *fa -= q.entries_of_row(a as u32).map(|(b, v)| v * (x[b as usize] - xa)).sum::<DVec3>();
     };
-    if f.len() < PARALLEL_TRIANGLES {
+    if f.len() < TEAM_TRIANGLES {
         f.iter_mut().enumerate().for_each(row);
+    } else if f.len() < PARALLEL_TRIANGLES {
+        let mid = f.len() / 2;
+        let (low, high) = f.split_at_mut(mid);
+        crate::sim::team::join(|| low.iter_mut().enumerate().for_each(row), || high.iter_mut().enumerate().for_each(|(a, fa)| row((mid + a, fa))));
     } else {
         f.par_iter_mut().enumerate().for_each(row);
     }

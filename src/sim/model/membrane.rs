@@ -2,7 +2,7 @@
 //! the measured tensile curves ([`MembraneLaw`]), its forces as edge tensions and its
 //! Hessian in 3×3 blocks.
 
-use super::{Model, PARALLEL_TRIANGLES, outer, sum_of};
+use super::{Model, TEAM_TRIANGLES, map_in_order, outer, sum_of};
 use crate::sim::linalg::{BlockCsr, ScalarCsr};
 use crate::sim::material::MembraneLaw;
 use glam::{DMat3, DVec2, DVec3};
@@ -45,7 +45,6 @@ impl Model {
     ///         e2
     /// ```
     pub(super) fn add_membrane_forces(&self, x: &[DVec3], f: &mut [DVec3]) {
-        use rayon::prelude::*;
         let Some(law) = &self.membrane_law else { return };
         let pulls = |tri: &RosetteTriangle| {
             let (strain, dirs, _) = rosette_strain(tri, x);
@@ -61,13 +60,13 @@ impl Model {
         };
         // Both paths add the same pulls in the same order: the forces do not depend on
         // the number of threads.
-        if self.rosettes.len() < PARALLEL_TRIANGLES {
+        if self.rosettes.len() < TEAM_TRIANGLES {
             for tri in &self.rosettes {
                 add(f, tri, pulls(tri));
             }
         } else {
-            let all: Vec<[DVec3; 3]> = self.rosettes.par_iter().map(pulls).collect();
-            for (tri, pull) in self.rosettes.iter().zip(all) {
+            let all = map_in_order(&self.rosettes, pulls);
+            for (tri, pull) in self.rosettes.iter().zip(all.into_iter().flatten()) {
                 add(f, tri, pull);
             }
         }
@@ -77,7 +76,6 @@ impl Model {
     /// Adds the membrane forces to `f` and returns the membrane energy, J: both from one
     /// pass over the triangles (the quasi-Newton step evaluates them at every trial).
     pub(super) fn add_membrane_energy_and_forces(&self, x: &[DVec3], f: &mut [DVec3]) -> f64 {
-        use rayon::prelude::*;
         let Some(law) = &self.membrane_law else { return 0.0 };
         let evaluate = |tri: &RosetteTriangle| {
             let (strain, dirs, _) = rosette_strain(tri, x);
@@ -94,13 +92,13 @@ impl Model {
                 f[b as usize] -= pull;
             }
         };
-        if self.rosettes.len() < PARALLEL_TRIANGLES {
+        if self.rosettes.len() < TEAM_TRIANGLES {
             for tri in &self.rosettes {
                 add(tri, evaluate(tri));
             }
         } else {
-            let all: Vec<(f64, [DVec3; 3])> = self.rosettes.par_iter().map(evaluate).collect();
-            for (tri, item) in self.rosettes.iter().zip(all) {
+            let all = map_in_order(&self.rosettes, evaluate);
+            for (tri, item) in self.rosettes.iter().zip(all.into_iter().flatten()) {
                 add(tri, item);
             }
         }
@@ -126,7 +124,6 @@ impl Model {
     /// that their 2|t|/l sum to at most `allowance[i]` bounds their total below by
     /// −Σ allowance[i] |d_i|².
     pub fn assemble_membrane_stiffness_within(&self, x: &[DVec3], k: &mut BlockCsr, compressed: CompressedEdges) {
-        use rayon::prelude::*;
         k.clear();
         if self.sewing.is_active() {
             self.sewing.add_stiffness(x, k);
@@ -148,13 +145,13 @@ impl Model {
                 }
             }
         };
-        if self.rosettes.len() < PARALLEL_TRIANGLES {
+        if self.rosettes.len() < TEAM_TRIANGLES {
             for tri in &self.rosettes {
                 add(k, tri, &triangle_stiffness(tri, law, x, &ratio));
             }
         } else {
-            let blocks: Vec<[DMat3; 6]> = self.rosettes.par_iter().map(|tri| triangle_stiffness(tri, law, x, &ratio)).collect();
-            for (tri, b) in self.rosettes.iter().zip(&blocks) {
+            let blocks = map_in_order(&self.rosettes, |tri| triangle_stiffness(tri, law, x, &ratio));
+            for (tri, b) in self.rosettes.iter().zip(blocks.iter().flatten()) {
                 add(k, tri, b);
             }
         }
