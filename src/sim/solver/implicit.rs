@@ -153,10 +153,9 @@ impl Integrator {
     /// Coulomb's cone about it (|f_t| ≤ margin·μ_s·f_n); one not held is held from the next
     /// step where it ends this one sticking with its friction within that margin.
     fn hold_sticking(&mut self, step: &ImplicitStep, contacts: &crate::sim::contact::StepContacts, y: &[DVec3], held: &mut Vec<Option<DVec3>>) {
-        let ImplicitStep { model, h, anchor, inertial, .. } = *step;
+        let model = step.model;
         let Some(contact) = &model.contact else { return };
         let mu = contact.settings.friction_static;
-        let zeta = model.options.damping;
         let n = y.len();
         let mut next = vec![None; n];
         if held.iter().any(Option::is_some) {
@@ -164,8 +163,7 @@ impl Integrator {
             model.forces(y, &mut self.forces);
             for i in 0..n {
                 let Some(normal) = held[i] else { continue };
-                let m = model.mass[i];
-                let holding = m / (h * h) * (y[i] - inertial[i]) + zeta * m / h * (y[i] - anchor[i]) - self.forces[i];
+                let holding = step.inertial_gradient(i, y[i], self.forces[i]);
                 let push = holding.dot(normal);
                 if push > 0.0 && (holding - push * normal).length() <= HOLD_MARGIN * mu * push {
                     next[i] = Some(normal);
@@ -219,6 +217,16 @@ impl ImplicitStep<'_> {
             .filter(|&i| !self.fixed[i])
             .map(|i| 0.5 * self.dt * ((y[i] - self.anchor[i]) / self.h - self.velocity[i]).length())
             .fold(0.0, f64::max)
+    }
+
+    /// ∂Φ/∂y at vertex `i` without contact, m/h²(y − x̃) + ζm/h(y − x̂) − f, for the vertex
+    /// at `y` with the elastic forces and gravity `force` on it: what holds a prescribed
+    /// vertex where it is, and Newton's and quasi-Newton's gradient on a free one.
+    #[inline]
+    pub fn inertial_gradient(&self, i: usize, y: DVec3, force: DVec3) -> DVec3 {
+        let (model, h) = (self.model, self.h);
+        let m = model.mass[i];
+        m / (h * h) * (y - self.inertial[i]) + model.options.damping * m / h * (y - self.anchor[i]) - force
     }
 
     /// The incremental potential Φ at `y` without contact.

@@ -197,18 +197,13 @@ impl Integrator {
 
     /// ∇Φ at `y` into `gradient` (zero on fixed vertices), and its norm.
     pub(super) fn gradient(&mut self, problem: &NewtonProblem, y: &[DVec3], gradient: &mut [DVec3], watch: &mut Stopwatch) -> f64 {
-        let ImplicitStep { model, h, anchor, inertial, fixed, .. } = *problem.step;
-        let zeta = model.options.damping;
+        let step = problem.step;
+        let ImplicitStep { model, fixed, .. } = *step;
         let n = y.len();
         self.forces.resize(n, DVec3::ZERO);
         model.forces(y, &mut self.forces);
-        let forces = &self.forces;
         for i in 0..n {
-            gradient[i] = if fixed[i] {
-                DVec3::ZERO
-            } else {
-                model.mass[i] / (h * h) * (y[i] - inertial[i]) + zeta * model.mass[i] / h * (y[i] - anchor[i]) - forces[i]
-            };
+            gradient[i] = if fixed[i] { DVec3::ZERO } else { step.inertial_gradient(i, y[i], self.forces[i]) };
         }
         watch.forces();
         if let Some(c) = problem.contacts {

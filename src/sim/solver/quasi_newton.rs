@@ -338,7 +338,7 @@ impl Integrator {
                 let m = model.mass[i];
                 let (to_inertial, to_anchor) = (y[i] - inertial[i], y[i] - anchor[i]);
                 phi += m / (2.0 * h * h) * to_inertial.length_squared() + zeta * m / (2.0 * h) * to_anchor.length_squared();
-                m / (h * h) * to_inertial + zeta * m / h * to_anchor - self.forces[i]
+                problem.step.inertial_gradient(i, y[i], self.forces[i])
             };
         }
         watch.forces();
