@@ -126,7 +126,14 @@ fn garment_loop(name: &str, scene: &str, path: &str, recut: &str) {
          [[step]]\nscreenshot = \"recut.png\"\n\
          [[step]]\nquit = true\n"
     );
-    let Some(played) = play(name, scene, &["--set", COARSE_EDGE, "--set", RED_LOOK, path], &script) else { return };
+    // The drag lasts 0.6 s of wall time, as many steps as the frames allow, so where it
+    // leaves the cloth depends on the machine's load: beside the suite's other tests it
+    // held the straight skirt from 7.51 to 8.90 s and the skirt had not settled again when
+    // the garment's 6 s from the drag ran out at 13.51 s; run alone, held to 8.81 s, it
+    // settled at 10.46 s. The session asks whether each change settles, not how fast: 15 s
+    // (docs/performance-log.md, "2026-12-08: the second core").
+    let args = ["--set", COARSE_EDGE, "--set", RED_LOOK, "--set", "scene.duration=15", path];
+    let Some(played) = play(name, scene, &args, &script) else { return };
     let report = &played.report;
     assert_eq!(played.code, Some(0), "{name}: {}\n{}", report["outcome"], played.stderr);
     let opened = report["opened"]["vertices"].as_u64().unwrap();
