@@ -22,6 +22,11 @@ use std::sync::{Mutex, OnceLock};
 use std::thread::{self, Thread};
 use std::time::{Duration, Instant};
 
+/// The fewest rows, triangles or items a pass is split over the team for: below it a pass
+/// takes a few microseconds, about what the hand-off costs. Above rayon's thresholds (4 096)
+/// the passes go to rayon's pool instead.
+pub const LEAST_ITEMS: usize = 1024;
+
 /// How long the thread spins for the next job before it sleeps: longer than the gaps
 /// between the passes of a conjugate-gradient solve, shorter than a Newton iteration's
 /// force assembly. 1 ms ran the tablecloth headless 8 % faster (`farm-bench -n 5`, A/B

@@ -528,9 +528,8 @@ impl ContactModel {
 const PARALLEL_TRIANGLES: usize = 4096;
 
 /// Below [`PARALLEL_TRIANGLES`], searches over at least this many items are split in two
-/// halves, one on the team's thread ([`crate::sim::team`]), whose hand-off costs far less
-/// than rayon's.
-const TEAM_ITEMS: usize = 1024;
+/// halves, one on the team's thread, whose hand-off costs far less than rayon's.
+use crate::sim::team::LEAST_ITEMS as TEAM_ITEMS;
 
 /// What `keep(i, &items[i])` returns, in the order of i (if `parallel`, fixed chunks on
 /// rayon's threads; else, from [`TEAM_ITEMS`] items, two halves, one on the team's). Every

@@ -53,9 +53,8 @@ pub(super) const PARALLEL_ROWS: usize = 4096;
 const CHUNK: usize = 256;
 
 /// From this many rows up to [`PARALLEL_ROWS`] a pass is split in two halves, one on the
-/// calling thread and one on the team's ([`crate::sim::team`]), whose hand-off costs far
-/// less than rayon's.
-pub(super) const TEAM_ROWS: usize = 1024;
+/// calling thread and one on the team's, whose hand-off costs far less than rayon's.
+pub(super) use crate::sim::team::LEAST_ITEMS as TEAM_ROWS;
 
 /// Calls `f(row, &mut y[row])` for every row: in two halves on the team from [`TEAM_ROWS`]
 /// rows, in chunks of [`CHUNK`] rows over rayon's pool from [`PARALLEL_ROWS`]. Each row is

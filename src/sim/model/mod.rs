@@ -364,9 +364,9 @@ impl Model {
 const PARALLEL_TRIANGLES: usize = 4096;
 
 /// From this many triangles (or vertices) up to [`PARALLEL_TRIANGLES`] a per-element map is
-/// split in two halves, one on the team's thread ([`crate::sim::team`]), whose hand-off costs
-/// far less than rayon's: on the tablecloth (3 200 triangles) a pass takes about a millisecond.
-const TEAM_TRIANGLES: usize = 1024;
+/// split in two halves, one on the team's thread, whose hand-off costs far less than
+/// rayon's: on the tablecloth (3 200 triangles) a pass takes about a millisecond.
+use crate::sim::team::LEAST_ITEMS as TEAM_TRIANGLES;
 
 /// `f` of every item, in order, as two runs of results (the second empty where the pool
 /// took them all): in two halves on the team below [`PARALLEL_TRIANGLES`] items, over
