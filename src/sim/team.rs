@@ -164,6 +164,13 @@ pub fn join<RA, RB: Send>(a: impl FnOnce() -> RA, b: impl FnOnce() -> RB + Send)
     }
 }
 
+/// [`join`] of two halves of a list: `a`'s results followed by `b`'s.
+pub fn join_in_order<T: Send>(a: impl FnOnce() -> Vec<T>, b: impl FnOnce() -> Vec<T> + Send) -> Vec<T> {
+    let (mut low, high) = join(a, b);
+    low.extend(high);
+    low
+}
+
 #[cfg(test)]
 mod tests {
     use super::join;

@@ -346,9 +346,10 @@ impl ContactModel {
 
 /// Runs `search(i, marks, found)` for every i < `count` and returns what it found, in the
 /// order of i whatever the number of threads (if `parallel`, fixed chunks on rayon's
-/// threads; else, from [`TEAM_ITEMS`] items, two halves, one on the team's). `marks` holds `marks_len` entries, u32::MAX at first, for the search
-/// to mark what item i has taken with i: each thread keeps one array for its chunks, which
-/// is sound because no two items share a number.
+/// threads; else, from [`TEAM_ITEMS`] items, two halves, one on the team's). `marks` holds
+/// `marks_len` entries, u32::MAX at first, for the search to mark what item i has taken
+/// with i: each thread keeps one array for its chunks, which is sound because no two items
+/// share a number.
 fn search_in_chunks<T: Send>(count: usize, marks_len: usize, parallel: bool, search: impl Fn(usize, &mut [u32], &mut Vec<T>) + Sync) -> Vec<T> {
     use rayon::prelude::*;
     const CHUNK: usize = 1024;
@@ -364,9 +365,7 @@ fn search_in_chunks<T: Send>(count: usize, marks_len: usize, parallel: bool, sea
         let parts: Vec<Vec<T>> = (0..count.div_ceil(CHUNK)).into_par_iter().map_init(fresh, |marks, c| run(c * CHUNK..((c + 1) * CHUNK).min(count), marks)).collect();
         parts.into_iter().flatten().collect()
     } else if count >= TEAM_ITEMS {
-        let (mut low, high) = crate::sim::team::join(|| run(0..count / 2, &mut fresh()), || run(count / 2..count, &mut fresh()));
-        low.extend(high);
-        low
+        crate::sim::team::join_in_order(|| run(0..count / 2, &mut fresh()), || run(count / 2..count, &mut fresh()))
     } else {
         run(0..count, &mut fresh())
     }

@@ -535,9 +535,9 @@ use crate::sim::team::LEAST_ITEMS as TEAM_ITEMS;
 /// rayon's threads; else, from [`TEAM_ITEMS`] items, two halves, one on the team's). Every
 /// path runs the same loop over a range, which `keep` is inlined into: with an iterator
 /// adapter on each path it is not, and the filters, run on every pair every step, are
-/// slower. The chunks are small enough for the threads to share the
-/// items evenly (in chunks of 4 096 a 10k garment's 5 247 vertices went 4 096 to one
-/// thread and 1 151 to the other); what is kept, and its order, do not depend on them.
+/// slower. The chunks are small enough for the threads to share the items evenly (in
+/// chunks of 4 096 a 10k garment's 5 247 vertices went 4 096 to one thread and 1 151 to the
+/// other); what is kept, and its order, do not depend on them.
 fn filter_in_order<T: Sync, U: Send>(items: &[T], parallel: bool, keep: impl Fn(usize, &T) -> Option<U> + Sync) -> Vec<U> {
     use rayon::prelude::*;
     const CHUNK: usize = 1024;
@@ -555,9 +555,7 @@ fn filter_in_order<T: Sync, U: Send>(items: &[T], parallel: bool, keep: impl Fn(
         let parts: Vec<Vec<U>> = (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| filter(c * CHUNK..((c + 1) * CHUNK).min(n))).collect();
         parts.into_iter().flatten().collect()
     } else if n >= TEAM_ITEMS {
-        let (mut low, high) = crate::sim::team::join(|| filter(0..n / 2), || filter(n / 2..n));
-        low.extend(high);
-        low
+        crate::sim::team::join_in_order(|| filter(0..n / 2), || filter(n / 2..n))
     } else {
         filter(0..n)
     }

@@ -223,9 +223,7 @@ fn in_order<T: Send>(n: usize, f: impl Fn(Range<usize>) -> T + Sync) -> Vec<T> {
     } else if n < PARALLEL_ROWS {
         let mid = chunks.div_ceil(2);
         let run = |range: Range<usize>| range.map(|c| f(rows(c))).collect::<Vec<T>>();
-        let (mut low, high) = crate::sim::team::join(|| run(0..mid), || run(mid..chunks));
-        low.extend(high);
-        low
+        crate::sim::team::join_in_order(|| run(0..mid), || run(mid..chunks))
     } else {
         (0..chunks).into_par_iter().map(|c| f(rows(c))).collect()
     }
@@ -250,9 +248,7 @@ fn in_order_mut<T: Send>(a: &mut [DVec3], b: &mut [DVec3], f: impl Fn(Range<usiz
         let mid = n.div_ceil(CHUNK).div_ceil(2);
         let (a_low, a_high) = a.split_at_mut(mid * CHUNK);
         let (b_low, b_high) = if b.is_empty() { (&mut [][..], &mut [][..]) } else { b.split_at_mut(mid * CHUNK) };
-        let (mut low, high) = crate::sim::team::join(|| serial(0, a_low, b_low), || serial(mid, a_high, b_high));
-        low.extend(high);
-        low
+        crate::sim::team::join_in_order(|| serial(0, a_low, b_low), || serial(mid, a_high, b_high))
     } else if b.is_empty() {
         a.par_chunks_mut(CHUNK).enumerate().map(|(c, a)| f(rows(c), a, &mut [])).collect()
     } else {
